@@ -1,0 +1,57 @@
+// Exact point-to-mesh distance with a robust inside/outside sign, for one mesh.
+//
+// Built once per mesh (a bounding volume hierarchy over its triangles plus per-feature
+// pseudo-normals) and refit, not rebuilt, when the vertices move. The distance is exact (the
+// closest point on the closest triangle). The sign comes from the angle-weighted pseudo-normal of
+// the closest feature (face, edge or vertex; Baerentzen & Aanaes 2005) on closed meshes, and from
+// the generalized winding number (Jacobson et al. 2013) where the mesh is open.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <span>
+
+#include <glm/vec3.hpp>
+
+#include "mesh.h"
+#include "status.h"
+
+namespace sdfg {
+
+struct ClosestPoint {
+  float distance = std::numeric_limits<float>::infinity();  // unsigned, metres
+  glm::vec3 point{0.0f};                                    // on the mesh
+  uint32_t triangle = 0;
+};
+
+class MeshDistance {
+ public:
+  // Takes its own copy of the mesh. Fails only on an invalid mesh (see validateMesh).
+  static Result<std::unique_ptr<MeshDistance>> create(const TriangleMesh& mesh);
+  ~MeshDistance();
+  MeshDistance(const MeshDistance&) = delete;
+  MeshDistance& operator=(const MeshDistance&) = delete;
+
+  // New vertex positions, same count and topology (animated or skinned meshes). Refits the
+  // hierarchy's bounds and recomputes pseudo-normals in O(n); no rebuild.
+  Status updatePositions(std::span<const glm::vec3> positions);
+
+  const TriangleMesh& mesh() const;
+  // True when every edge has exactly two triangles (no boundary, no non-manifold edge).
+  bool isClosed() const;
+
+  ClosestPoint closest(const glm::vec3& p) const;
+  // Skips subtrees farther than `maxDistance`; returns infinity when nothing is that close.
+  ClosestPoint closestWithin(const glm::vec3& p, float maxDistance) const;
+  float signedDistance(const glm::vec3& p) const;
+  // Generalized winding number: ~1 inside, ~0 outside, fractional near holes.
+  float windingNumber(const glm::vec3& p) const;
+
+ private:
+  struct Impl;
+  explicit MeshDistance(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sdfg

@@ -1,0 +1,77 @@
+// The grasp solver interface: given where the target is relative to the hand, find how far each
+// finger closes before it touches.
+//
+// Strategies ("paper", "physics-convex", "physics-mesh", later "ours") implement GraspSolver.
+// Callers create one by name, prepare() it once per hand model and box (that is where curve
+// caches are built), then call solve() per grasp. A strategy says which representation of the
+// target it reads: the grab-box SDF, or a Bullet collider.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "hand_model.h"
+#include "pose.h"
+#include "sdf_grid.h"
+#include "status.h"
+
+namespace sdfg {
+
+class PhysicsCollider;  // solver_physics.h
+
+struct SolverOptions {
+  float da = 0.1f;              // curl step along each finger's curve, in (0, 1]
+  float threshold = -1.0f;      // stop distance in metres; < 0: each finger's tip radius
+  float refineStep = 0.01f;     // physics strategies: the fine step after the coarse one
+};
+
+struct FingerState {
+  float curl = 0.0f;             // overall curl of the finger (its tip's curve parameter)
+  JointCurls jointCurls{};       // per joint; all equal to `curl` for single-curl strategies
+  bool contact = false;          // stopped on the surface (false: closed fully without touching)
+  glm::vec3 contactPoint{0.0f};  // hand space: where the finger touches (the stopping sphere's centre)
+  float distance = 0.0f;         // the target's distance at contactPoint as the strategy saw it
+};
+
+struct GraspResult {
+  std::array<FingerState, kFingerCount> fingers{};
+};
+
+// The target as the solvers see it. Only the representation a strategy asks for must be set.
+struct GraspScene {
+  const SdfGrid* field = nullptr;             // SDF of the target in the grab box (hand space)
+  const PhysicsCollider* collider = nullptr;  // Bullet collider of the target (object space)
+  Pose objectFromHand;                        // hand-space point -> object space
+};
+
+class GraspSolver {
+ public:
+  virtual ~GraspSolver() = default;
+
+  virtual std::string_view name() const = 0;
+  virtual bool needsField() const = 0;
+  virtual bool needsCollider() const = 0;
+
+  // Caches what depends only on the hand model, the box and the options (the finger curves in
+  // box coordinates). Call again when any of them changes. Fails on invalid options.
+  virtual Status prepare(const HandModel& hand, const GridBox& box,
+                         const SolverOptions& options) = 0;
+
+  // Solves one grasp into `out`. Fails when not prepared or when the scene lacks what
+  // needsField()/needsCollider() ask for. Never allocates for the SDF strategies.
+  virtual Status solve(const GraspScene& scene, GraspResult& out) const = 0;
+};
+
+// Names accepted by createSolver(), in the order the benchmark lists them.
+std::vector<std::string> solverNames();
+
+// Creates a strategy by name; an unknown name is an invalid_argument error listing the known ones.
+Result<std::unique_ptr<GraspSolver>> createSolver(std::string_view name);
+
+}  // namespace sdfg

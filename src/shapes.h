@@ -1,0 +1,38 @@
+// Procedural objects generated in code: the embedded defaults of the demo and benchmark, and
+// analytic shapes for tests. No data files. All meshes are closed (watertight) with outward,
+// counter-clockwise faces, in metres, centred near the origin.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mesh.h"
+
+namespace sdfg {
+
+// A mug with a handle: a cup (concave: an open cavity) and a handle that leaves a through-hole
+// between it and the wall; one closed genus-1 surface. About 8 cm across and 9.5 cm tall.
+TriangleMesh makeMug();
+
+// A torus in the XZ plane (axis Y): ring radius `major`, tube radius `minor`.
+TriangleMesh makeTorus(float major = 0.05f, float minor = 0.015f, int ringSegments = 48,
+                       int tubeSegments = 24);
+
+// A thin rectangular plate (a box) centred at the origin, thickness along Y.
+TriangleMesh makeThinPlate(float width = 0.14f, float depth = 0.10f, float thickness = 0.004f);
+
+// An axis-aligned box centred at the origin with the given full extents.
+TriangleMesh makeBox(const glm::vec3& extent);
+
+// A sphere (subdivided icosahedron) centred at the origin.
+TriangleMesh makeSphere(float radius, int subdivisions = 3);
+
+struct NamedMesh {
+  std::string name;
+  TriangleMesh mesh;
+};
+
+// The embedded default objects: mug, torus, thin plate.
+std::vector<NamedMesh> embeddedObjects();
+
+}  // namespace sdfg

@@ -34,7 +34,7 @@ layout(std140, set = 0, binding = 0) uniform BuildParams {
   uint levelCount3;
   uint levelCount4;
   float windingBeta;    // a cluster farther than beta * radius uses its dipole approximation
-  uint pad0;
+  uint signMode;       // 0: winding number; 1: pseudo-normals of binding 11 (closed meshes)
   uint pad1;
   uint pad2;
 } P;
@@ -89,4 +89,34 @@ vec3 closestOnTriangle(vec3 p, vec3 a, vec3 b, vec3 c) {
 float triangleDistance(vec3 p, uint t) {
   vec3 a = tri[3u * t].xyz, b = tri[3u * t + 1u].xyz, c = tri[3u * t + 2u].xyz;
   return length(p - closestOnTriangle(p, a, b, c));
+}
+
+// Same as closestOnTriangle, also naming the closest feature: 0 face, 1 + e edge e (edge 0 is
+// a-b, 1 is b-c, 2 is c-a), 4 + k corner k.
+vec3 closestOnTriangleFeature(vec3 p, vec3 a, vec3 b, vec3 c, out uint feature) {
+  vec3 ab = b - a, ac = c - a, ap = p - a;
+  float d1 = dot(ab, ap), d2 = dot(ac, ap);
+  feature = 4u;
+  if (d1 <= 0.0 && d2 <= 0.0) return a;
+  vec3 bp = p - b;
+  float d3 = dot(ab, bp), d4 = dot(ac, bp);
+  feature = 5u;
+  if (d3 >= 0.0 && d4 <= d3) return b;
+  float vc = d1 * d4 - d3 * d2;
+  feature = 1u;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return a + ab * (d1 / (d1 - d3));
+  vec3 cp = p - c;
+  float d5 = dot(ab, cp), d6 = dot(ac, cp);
+  feature = 6u;
+  if (d6 >= 0.0 && d5 <= d6) return c;
+  float vb = d5 * d2 - d1 * d6;
+  feature = 3u;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return a + ac * (d2 / (d2 - d6));
+  float va = d3 * d6 - d5 * d4;
+  feature = 2u;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0)
+    return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  feature = 0u;
+  float denom = 1.0 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
 }

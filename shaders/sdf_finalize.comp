@@ -1,12 +1,12 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Pass 5, one invocation per node: the exact distance to the node's propagated closest triangle,
-// signed by the generalized winding number of the whole mesh (Jacobson et al. 2013): inside
-// where it exceeds 0.5. The winding number is summed over the hierarchy of pass 2, exact for
+// signed, on closed and consistently oriented meshes given as arrays, by the pseudo-normal of the
+// closest feature (as the CPU builder does), and otherwise by the generalized winding number of
+// the whole mesh (Jacobson et al. 2013): inside where it exceeds 0.5. The winding number is summed over the hierarchy of pass 2, exact for
 // triangles in nodes closer than beta * radius, the node's dipole term beyond (Barill et al.
-// 2018). It is exact on closed meshes away from the surface and degrades gracefully at holes,
-// so one sign rule serves closed and open meshes, and needs no adjacency: the app's skinned
-// buffers work as they are.
+// 2018). It degrades gracefully at holes and needs no adjacency: the app's skinned buffers work
+// as they are.
 #include "sdf_common.glsl"
 
 struct HierarchyNode {
@@ -19,6 +19,10 @@ layout(std430, set = 0, binding = 6) readonly buffer IdsA { uint idsA[]; };
 layout(std430, set = 0, binding = 7) readonly buffer IdsB { uint idsB[]; };
 // Binding 8: the signed distances, node-centred, values[i + Nx * (j + Ny * k)].
 layout(std430, set = 0, binding = 8) writeonly buffer Values { float values[]; };
+
+// Binding 11: per triangle, object-space pseudo-normals of its edges 0..2 then corners 0..2
+// (equal-weight edge normals, angle-weighted vertex normals; Baerentzen & Aanaes 2005).
+layout(std430, set = 0, binding = 11) readonly buffer PseudoNormals { vec4 pseudoNormals[]; };
 
 layout(push_constant) uniform Push { uint step; uint flip; } pc;
 
@@ -77,6 +81,22 @@ void main() {
   uint id = pc.flip == 0u ? idsA[v] : idsB[v];
   // No triangle within the cull margin: the surface is farther than the margin; spacing.w holds
   // the value to report (the margin), signed below like every other node.
-  float d = id == kNoTriangle ? P.spacing.w : triangleDistance(p, id);
-  values[v] = windingNumber(p) > 0.5 ? -d : d;
+  if (id == kNoTriangle) {
+    values[v] = P.signMode == 1u ? P.spacing.w : (windingNumber(p) > 0.5 ? -P.spacing.w : P.spacing.w);
+    return;
+  }
+  vec3 a = tri[3u * id].xyz, b = tri[3u * id + 1u].xyz, c = tri[3u * id + 2u].xyz;
+  uint feature;
+  vec3 q = closestOnTriangleFeature(p, a, b, c, feature);
+  float d = length(p - q);
+  bool inside;
+  if (P.signMode == 1u) {
+    // Closed, consistently oriented mesh: the side of the closest feature's pseudo-normal.
+    vec3 n = feature == 0u ? cross(b - a, c - a)
+                           : mat3(P.boxFromObject) * pseudoNormals[6u * id + feature - 1u].xyz;
+    inside = dot(p - q, n) < 0.0;
+  } else {
+    inside = windingNumber(p) > 0.5;
+  }
+  values[v] = inside ? -d : d;
 }

@@ -29,13 +29,21 @@ void main() {
     ivec3 base = ivec3(ijk);
     ivec3 n = ivec3(P.res.xyz);
     int s = int(pc.step);
+    uint last = best;  // neighbours often share one id: evaluate a repeat only once
     for (int dz = -1; dz <= 1; ++dz) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
           ivec3 q = base + ivec3(dx, dy, dz) * s;
           if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, n))) continue;
           uint cand = readId(uint(q.x) + P.res.x * (uint(q.y) + P.res.y * uint(q.z)));
-          if (cand == kNoTriangle || cand == best) continue;
+          if (cand == kNoTriangle || cand == best || cand == last) continue;
+          last = cand;
+          // Lower bound from the sphere about corner a through the farther corner: a
+          // candidate that cannot beat the best skips the exact distance.
+          vec3 a = tri[3u * cand].xyz;
+          float reach = sqrt(max(dot(tri[3u * cand + 1u].xyz - a, tri[3u * cand + 1u].xyz - a),
+                                 dot(tri[3u * cand + 2u].xyz - a, tri[3u * cand + 2u].xyz - a)));
+          if (length(p - a) - reach >= bestD) continue;
           float d = triangleDistance(p, cand);
           if (d < bestD) {
             bestD = d;

@@ -32,12 +32,19 @@ void main() {
   vec3 a = a4.xyz, b = tri[3u * t + 1u].xyz, c = tri[3u * t + 2u].xyz;
   uvec3 lo = nodeRangeLow(min(a, min(b, c)));
   uvec3 hi = nodeRangeHigh(max(a, max(b, c)));
+  float seedReach = 2.0 * max(P.spacing.x, max(P.spacing.y, P.spacing.z));
+  bool outside = any(greaterThan(max(a, max(b, c)), P.boxHalf.xyz)) ||
+                 any(lessThan(min(a, min(b, c)), -P.boxHalf.xyz));
   for (uint k = lo.z; k <= hi.z; ++k) {
     for (uint j = lo.y; j <= hi.y; ++j) {
       for (uint i = lo.x; i <= hi.x; ++i) {
         uint v = i + P.res.x * (j + P.res.y * k);
-        uint bits = floatBitsToUint(length(nodePosition(uvec3(i, j, k)) -
-                                           closestOnTriangle(nodePosition(uvec3(i, j, k)), a, b, c)));
+        vec3 p = nodePosition(uvec3(i, j, k));
+        float d = length(p - closestOnTriangle(p, a, b, c));
+        // Beyond two spacings a seed adds nothing the flood would not find: skip the atomic.
+        // (Nodes of the boundary layer seeded for triangles outside the box are always kept.)
+        if (d > seedReach && !outside) continue;
+        uint bits = floatBitsToUint(d);
         if (pc.mode == 0u) {
           atomicMin(distBits[v], bits);
         } else if (distBits[v] == bits) {

@@ -99,6 +99,10 @@ void destroyVk(const VkContext& c, VkFence h) {
   c.fn().vkDestroyFence(c.handle(), h, nullptr);
 }
 
+void destroyVk(const VkContext& c, VkQueryPool h) {
+  c.fn().vkDestroyQueryPool(c.handle(), h, nullptr);
+}
+
 Result<VkBufferAlloc> createBuffer(const VkContext& ctx, VkDeviceSize size,
                                    VkBufferUsageFlags usage, VkMemoryKind kind) {
   const VkFunctions& fn = ctx.fn();

@@ -78,7 +78,12 @@ struct VkFunctions {
   X(vkResetFences)                  \
   X(vkGetFenceStatus)               \
   X(vkWaitForFences)                \
-  X(vkQueueSubmit)
+  X(vkQueueSubmit)                  \
+  X(vkCreateQueryPool)              \
+  X(vkDestroyQueryPool)             \
+  X(vkCmdResetQueryPool)            \
+  X(vkCmdWriteTimestamp)            \
+  X(vkGetQueryPoolResults)
 #define SDFG_VK_DECLARE(name) PFN_##name name = nullptr;
   SDFG_VK_INSTANCE_FUNCTIONS(SDFG_VK_DECLARE)
   SDFG_VK_DEVICE_FUNCTIONS(SDFG_VK_DECLARE)
@@ -129,6 +134,7 @@ void destroyVk(const VkContext& ctx, VkPipeline h);
 void destroyVk(const VkContext& ctx, VkDescriptorPool h);
 void destroyVk(const VkContext& ctx, VkCommandPool h);
 void destroyVk(const VkContext& ctx, VkFence h);
+void destroyVk(const VkContext& ctx, VkQueryPool h);
 
 // Sole owner of one Vulkan object; destroys it when reset or destroyed. Move-only. The context
 // must outlive it (VkSdfBuilder declares its context first, so it is destroyed last).

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <iostream>
+#include <optional>
 
 #include <glm/gtc/quaternion.hpp>
 
@@ -19,13 +20,14 @@ namespace L = vk_layout;
 namespace {
 
 enum Pass : uint32_t { kTransform, kCluster, kSplat, kJfa, kFinalize, kSample, kPassCount };
+constexpr uint32_t kTimestampCount = kPassCount + 1;  // before the first pass and after each
 
 // Buffers the builder owns, by role.
 enum Slot : uint32_t {
   kParamsBuf,   // BuildParams, written by the host before each submission
   kMeshPos,     // uploaded positions (CPU-array meshes)
   kMeshIdx,     // uploaded 32-bit indices (CPU-array meshes)
-  kStaging,     // host copy of positions then indices, copied by the next build
+  kStaging,     // host copy of positions, indices, pseudo-normals; copied by the next build
   kTris,        // triangles in box space
   kNodes,       // winding-number hierarchy
   kDistBits,    // splat minimum per node
@@ -35,6 +37,7 @@ enum Slot : uint32_t {
   kPoints,      // points to sample, written by the host
   kSamples,     // sampled values, read by the host
   kValuesHost,  // copy of the SDF for the host (readBackGrid)
+  kNormals,     // per-triangle pseudo-normals (closed CPU-array meshes)
   kSlotCount,
 };
 
@@ -59,6 +62,57 @@ uint32_t spreadBits(uint32_t v) {
   v = (v | (v << 4)) & 0x030c30c3u;
   v = (v | (v << 2)) & 0x09249249u;
   return v;
+}
+
+// Pseudo-normals of every triangle's edges and corners when the mesh is closed (every edge has
+// two triangles) and consistently oriented (they traverse it in opposite directions), in the
+// mesh's triangle order; nothing otherwise (those meshes are signed by the winding number).
+std::optional<std::vector<L::TrianglePseudoNormals>> pseudoNormals(const TriangleMesh& mesh) {
+  const size_t triangles = mesh.triangleCount();
+  struct HalfEdge {
+    uint64_t key;
+    uint32_t slot;  // 3 * triangle + edge
+  };
+  std::vector<HalfEdge> half(3 * triangles);
+  for (size_t t = 0; t < triangles; ++t) {
+    for (uint32_t e = 0; e < 3; ++e) {
+      const uint32_t u = mesh.indices[3 * t + e], v = mesh.indices[3 * t + (e + 1) % 3];
+      half[3 * t + e] = {(uint64_t(std::min(u, v)) << 32) | std::max(u, v), uint32_t(3 * t + e)};
+    }
+  }
+  std::sort(half.begin(), half.end(),
+            [](const HalfEdge& x, const HalfEdge& y) { return x.key < y.key; });
+  std::vector<glm::dvec3> face(triangles), vertex(mesh.vertexCount(), glm::dvec3(0.0));
+  for (size_t t = 0; t < triangles; ++t) {
+    const glm::dvec3 p[3] = {glm::dvec3(mesh.positions[mesh.indices[3 * t]]),
+                             glm::dvec3(mesh.positions[mesh.indices[3 * t + 1]]),
+                             glm::dvec3(mesh.positions[mesh.indices[3 * t + 2]])};
+    face[t] = glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0]));
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec3 e1 = glm::normalize(p[(k + 1) % 3] - p[k]);
+      const glm::dvec3 e2 = glm::normalize(p[(k + 2) % 3] - p[k]);
+      vertex[mesh.indices[3 * t + k]] +=
+          std::acos(std::clamp(glm::dot(e1, e2), -1.0, 1.0)) * face[t];
+    }
+  }
+  std::vector<L::TrianglePseudoNormals> out(triangles);
+  for (size_t i = 0; i < half.size(); i += 2) {
+    if (i + 1 >= half.size() || half[i].key != half[i + 1].key ||
+        (i + 2 < half.size() && half[i + 2].key == half[i].key)) {
+      return std::nullopt;  // a boundary or non-manifold edge
+    }
+    const uint32_t s0 = half[i].slot, s1 = half[i + 1].slot;
+    if (mesh.indices[s0] == mesh.indices[s1]) return std::nullopt;  // neighbours disagree
+    const glm::vec4 n(glm::vec3(face[s0 / 3] + face[s1 / 3]), 0.0f);
+    out[s0 / 3].edge[s0 % 3] = n;
+    out[s1 / 3].edge[s1 % 3] = n;
+  }
+  for (size_t t = 0; t < triangles; ++t) {
+    for (int k = 0; k < 3; ++k) {
+      out[t].corner[k] = glm::vec4(glm::vec3(vertex[mesh.indices[3 * t + k]]), 0.0f);
+    }
+  }
+  return out;
 }
 
 glm::mat4 poseMatrix(const Pose& pose) {
@@ -122,6 +176,7 @@ struct VkSdfBuilder::Objects {
   VkOwned<VkCommandPool> commandPool;    // owns `cmd`; family = the borrowed queue's
   VkCommandBuffer cmd = VK_NULL_HANDLE;  // re-recorded for every submission
   VkOwned<VkFence> fence;                // signalled when a submission completes (polled)
+  VkOwned<VkQueryPool> timestamps;       // pass boundaries, only with options.profile
   std::array<VkBufferAlloc, kSlotCount> buffers;
   std::array<uint32_t, kSlotCount> kinds{};
   bool descriptorsDirty = true;
@@ -261,14 +316,29 @@ Result<std::unique_ptr<VkSdfBuilder>> VkSdfBuilder::create(const VulkanDevice& d
   }
   o.fence = VkOwned<VkFence>(c, fence);
 
-  o.kinds = {kUpload, kDevice, kDevice, kUpload, kDevice,   kDevice,  kDevice,
-             kDevice, kDevice, kDevice, kUpload, kReadback, kReadback};
+  uint32_t familyCount = 0;
+  fn.vkGetPhysicalDeviceQueueFamilyProperties(device.physicalDevice, &familyCount, nullptr);
+  std::vector<VkQueueFamilyProperties> families(familyCount);
+  fn.vkGetPhysicalDeviceQueueFamilyProperties(device.physicalDevice, &familyCount, families.data());
+  if (options.profile && families[device.queueFamilyIndex].timestampValidBits > 0) {
+    auto queryInfo = vkStruct<VkQueryPoolCreateInfo>(VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO);
+    queryInfo.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    queryInfo.queryCount = kTimestampCount;
+    VkQueryPool queries = VK_NULL_HANDLE;
+    if (VkResult r = fn.vkCreateQueryPool(dev, &queryInfo, nullptr, &queries)) {
+      return error(r, "vkCreateQueryPool");
+    }
+    o.timestamps = VkOwned<VkQueryPool>(c, queries);
+  }
+
+  o.kinds = {kUpload, kDevice, kDevice, kUpload, kDevice,   kDevice,   kDevice,
+             kDevice, kDevice, kDevice, kUpload, kReadback, kReadback, kDevice};
   // Every binding gets a buffer now, so the descriptor set is complete before the first build.
   if (Status s = b->ensureBuffer(kParamsBuf, L::kBuildParamsBytes, kUpload); s != Status::ok) {
     return makeError(s, b->failure_);
   }
   if (Status s = b->ensureBuffers(8, 1, false); s != Status::ok) return makeError(s, b->failure_);
-  for (Slot slot : {kMeshPos, kMeshIdx}) {
+  for (Slot slot : {kMeshPos, kMeshIdx, kNormals}) {
     if (Status s = b->ensureBuffer(slot, 16, kDevice); s != Status::ok) {
       return makeError(s, b->failure_);
     }
@@ -372,7 +442,7 @@ void VkSdfBuilder::updateDescriptors() {
   std::array<VkDescriptorBufferInfo, L::kBindingCount> infos{};
   const std::array<Slot, L::kBindingCount> slots = {kParamsBuf, kMeshPos,  kMeshIdx, kTris,
                                                     kNodes,     kDistBits, kIdsA,    kIdsB,
-                                                    kValues,    kPoints,   kSamples};
+                                                    kValues,    kPoints,   kSamples, kNormals};
   std::array<VkWriteDescriptorSet, L::kBindingCount> writes{};
   for (uint32_t i = 0; i < L::kBindingCount; ++i) {
     infos[i].buffer = objects_->buffers[slots[i]].buffer.get();
@@ -414,10 +484,16 @@ Status VkSdfBuilder::setMesh(const TriangleMesh& mesh) {
   }
   std::sort(order.begin(), order.end());
 
+  const auto normals = pseudoNormals(mesh);
   const size_t posBytes = size_t(vertices) * 12, idxBytes = size_t(triangles) * 12;
+  const size_t normalBytes = normals ? normals->size() * sizeof(L::TrianglePseudoNormals) : 0;
   if (Status s = ensureBuffer(kMeshPos, posBytes, kDevice); s != Status::ok) return s;
   if (Status s = ensureBuffer(kMeshIdx, idxBytes, kDevice); s != Status::ok) return s;
-  if (Status s = ensureBuffer(kStaging, posBytes + idxBytes, kUpload); s != Status::ok) return s;
+  if (Status s = ensureBuffer(kNormals, normalBytes, kDevice); s != Status::ok) return s;
+  if (Status s = ensureBuffer(kStaging, posBytes + idxBytes + normalBytes, kUpload);
+      s != Status::ok) {
+    return s;
+  }
   VkBufferAlloc& staging = objects_->buffers[kStaging];
   auto* bytes = static_cast<unsigned char*>(staging.mapped);
   std::memcpy(bytes, mesh.positions.data(), posBytes);
@@ -425,10 +501,15 @@ Status VkSdfBuilder::setMesh(const TriangleMesh& mesh) {
   for (uint32_t t = 0; t < triangles; ++t) {
     std::memcpy(idx + 3 * t, &mesh.indices[3 * size_t(order[t].second)], 12);
   }
+  if (normals) {
+    auto* n = reinterpret_cast<L::TrianglePseudoNormals*>(bytes + posBytes + idxBytes);
+    for (uint32_t t = 0; t < triangles; ++t) n[t] = (*normals)[order[t].second];
+  }
   if (VkResult r = flushBuffer(*ctx_, staging)) return fail(r, "vkFlushMappedMemoryRanges");
 
   if (meshSource_ == MeshSource::app) objects_->descriptorsDirty = true;
   meshSource_ = MeshSource::cpu;
+  pseudoNormalSign_ = normals.has_value();
   triangleCount_ = triangles;
   vertexCount_ = vertices;
   uploadPending_ = true;
@@ -449,6 +530,7 @@ Status VkSdfBuilder::setMesh(const VkMeshBuffers& m) {
   }
   appMesh_ = m;
   meshSource_ = MeshSource::app;
+  pseudoNormalSign_ = false;
   triangleCount_ = m.indexCount / 3;
   vertexCount_ = m.vertexCount;
   uploadPending_ = false;
@@ -499,6 +581,7 @@ Status VkSdfBuilder::submitBuild(const GridBox& box, const Pose& objectFromHand,
     params.levelCount[l] = h.count[l];
   }
   params.windingBeta = options_.windingBeta;
+  params.signMode = pseudoNormalSign_ ? 1 : 0;
   VkBufferAlloc& pb = objects_->buffers[kParamsBuf];
   std::memcpy(pb.mapped, &params, sizeof(params));
   if (VkResult r = flushBuffer(*ctx_, pb)) return fail(r, "vkFlushMappedMemoryRanges");
@@ -579,6 +662,16 @@ Status VkSdfBuilder::record(bool build, size_t pointCount, bool readBack) {
     fn.vkCmdDispatch(cmd, ceilDiv(std::max<size_t>(items, 1), workGroupSize_), 1, 1);
   };
 
+  const VkQueryPool queries = o.timestamps.get();
+  if (queries) fn.vkCmdResetQueryPool(cmd, queries, 0, kTimestampCount);
+  // Timestamp `index` once every earlier command has finished (bottom of pipe).
+  auto stamp = [&](uint32_t index) {
+    if (queries) {
+      fn.vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries, index);
+    }
+  };
+  stamp(0);
+
   const size_t nodeCount = box_.nodeCount();
   if (build) {
     if (uploadPending_) {
@@ -589,6 +682,12 @@ Status VkSdfBuilder::record(bool build, size_t pointCount, bool readBack) {
                          &pos);
       fn.vkCmdCopyBuffer(cmd, o.buffers[kStaging].buffer.get(), o.buffers[kMeshIdx].buffer.get(), 1,
                          &idx);
+      if (pseudoNormalSign_) {
+        VkBufferCopy normals{posBytes + idxBytes, 0,
+                             VkDeviceSize(triangleCount_) * sizeof(L::TrianglePseudoNormals)};
+        fn.vkCmdCopyBuffer(cmd, o.buffers[kStaging].buffer.get(), o.buffers[kNormals].buffer.get(),
+                           1, &normals);
+      }
       // The uploaded mesh must land before the transform pass reads it.
       barrier(kTransfer, VK_ACCESS_TRANSFER_WRITE_BIT, kCompute, kRead);
     }
@@ -606,18 +705,22 @@ Status VkSdfBuilder::record(bool build, size_t pointCount, bool readBack) {
     dispatch(kTransform, triangleCount_, {});
     // Box-space triangles are written before the hierarchy and splat passes read them.
     computeToCompute();
+    stamp(1);
+    // The hierarchy serves only the winding number.
     const Hierarchy h = planHierarchy(triangleCount_);
-    for (uint32_t level = 0; level < h.levels; ++level) {
+    for (uint32_t level = 0; level < h.levels && !pseudoNormalSign_; ++level) {
       dispatch(kCluster, h.count[level], {level, 0});
       // Level l's nodes are written before level l + 1 (and the final pass) reads them.
       computeToCompute();
     }
+    stamp(2);
     dispatch(kSplat, triangleCount_, {0, 0});
     // Every atomic minimum must be done before mode 1 compares against the minimum.
     computeToCompute();
     dispatch(kSplat, triangleCount_, {1, 0});
     // Seed ids are written before the first flood step reads them.
     computeToCompute();
+    stamp(3);
     uint32_t flip = 0;
     for (uint32_t step :
          jumpSteps(std::max({box_.resolution.x, box_.resolution.y, box_.resolution.z}))) {
@@ -627,15 +730,19 @@ Status VkSdfBuilder::record(bool build, size_t pointCount, bool readBack) {
       computeToCompute();
       flip ^= 1u;
     }
+    stamp(4);
     dispatch(kFinalize, nodeCount, {0, flip});
     // The SDF is written before sampling and the host copy read it.
     barrier(kCompute, kWrite, kCompute | kTransfer, kRead | VK_ACCESS_TRANSFER_READ_BIT);
+    stamp(5);
   }
   if (pointCount > 0) {
     dispatch(kSample, pointCount, {});
     // Sampled values are written before the host reads them after the fence.
     barrier(kCompute, kWrite, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
   }
+  stamp(6);
+  profiledBuild_ = build && queries != VK_NULL_HANDLE;
   if (readBack) {
     VkBufferCopy copy{0, 0, nodeCount * 4};
     fn.vkCmdCopyBuffer(cmd, o.buffers[kValues].buffer.get(), o.buffers[kValuesHost].buffer.get(), 1,
@@ -669,6 +776,18 @@ Status VkSdfBuilder::submitRecorded() {
 void VkSdfBuilder::collectResults() {
   pending_ = false;
   Objects& o = *objects_;
+  passTimesMs_.clear();
+  if (profiledBuild_) {
+    uint64_t ticks[kTimestampCount] = {};
+    if (ctx_->fn().vkGetQueryPoolResults(ctx_->handle(), o.timestamps.get(), 0, kTimestampCount,
+                                         sizeof(ticks), ticks, sizeof(uint64_t),
+                                         VK_QUERY_RESULT_64_BIT) == VK_SUCCESS) {
+      const double msPerTick = double(ctx_->properties().limits.timestampPeriod) * 1e-6;
+      for (uint32_t i = 1; i < kTimestampCount; ++i) {
+        passTimesMs_.push_back(double(ticks[i] - ticks[i - 1]) * msPerTick);
+      }
+    }
+  }
   if (VkResult r = invalidateBuffer(*ctx_, o.buffers[kSamples])) {
     fail(r, "vkInvalidateMappedMemoryRanges");
     return;

@@ -7,9 +7,12 @@
 // exact distances splat into the nodes within one spacing of each triangle (their closest
 // triangle is exact); jump flooding (step N/2 .. 1, then 2, 1) carries closest-triangle ids to
 // every other node, each keeping the candidate at the smallest exact distance; the final value
-// is the exact distance to that triangle, signed everywhere by the generalized winding number
-// (> 0.5 inside), summed over a 32-ary hierarchy of triangle clusters with a dipole far field.
-// The winding number needs no adjacency, so skinned meshes in the app's buffers work unchanged.
+// is the exact distance to that triangle. The sign follows the CPU builder: on a closed,
+// consistently oriented mesh given as arrays, the angle-weighted pseudo-normal of the closest
+// feature (computed on the CPU at setMesh); otherwise (open meshes, the app's buffers) the
+// generalized winding number (> 0.5 inside), summed over a 32-ary hierarchy of triangle clusters
+// with a dipole far field. It needs no adjacency, so skinned meshes in app buffers work as they
+// are, at a higher cost.
 //
 // Frame path: submit*() records and submits one command buffer and returns at once; poll()
 // checks the fence without waiting. One submission is in flight at a time. Every Vulkan object
@@ -57,6 +60,8 @@ struct VkSdfOptions {
   // A hierarchy cluster farther than beta times its radius uses its dipole term. 2 keeps the
   // winding number within about 1e-3 of the exact sum on the test meshes.
   float windingBeta = 2.0f;
+  // Time each pass of a build with GPU timestamps (see passTimesMs()); off in the frame path.
+  bool profile = false;
   // Where the one failure line goes; stderr when empty.
   std::function<void(const std::string&)> log;
 };
@@ -110,6 +115,11 @@ class VkSdfBuilder {
   // The last built grid when it was read back; null otherwise.
   const SdfGrid* grid() const { return gridValid_ ? &grid_ : nullptr; }
 
+  // With VkSdfOptions::profile and a device that has timestamps: milliseconds of the last
+  // build's passes, in order transform, hierarchy, splat, flood, finalize, sample. Empty
+  // otherwise.
+  std::span<const double> passTimesMs() const { return passTimesMs_; }
+
   bool failed() const { return failed_; }
   const std::string& failure() const { return failure_; }
   const VkContext& context() const { return *ctx_; }
@@ -143,6 +153,7 @@ class VkSdfBuilder {
   uint32_t triangleCount_ = 0;
   uint32_t vertexCount_ = 0;
   bool uploadPending_ = false;
+  bool pseudoNormalSign_ = false;  // closed CPU-array mesh: sign from pseudo-normals
 
   // Last build and results.
   GridBox box_{};
@@ -152,8 +163,10 @@ class VkSdfBuilder {
   bool everSubmitted_ = false;
   size_t pointCount_ = 0;
   std::vector<float> samples_;
+  std::vector<double> passTimesMs_;
   SdfGrid grid_;
   bool gridValid_ = false;
+  bool profiledBuild_ = false;
 
   bool failed_ = false;
   bool simulateLost_ = false;

@@ -33,7 +33,8 @@ struct BuildParams {
   uint32_t levelOffset[kMaxLevels];
   uint32_t levelCount[kMaxLevels];
   float windingBeta;
-  uint32_t pad[3];
+  uint32_t signMode;  // 0: winding number; 1: pseudo-normals (binding 11)
+  uint32_t pad[2];
 };
 static_assert(offsetof(BuildParams, boxHalf) == 64);
 static_assert(offsetof(BuildParams, spacing) == 80);
@@ -43,6 +44,7 @@ static_assert(offsetof(BuildParams, pointCount) == 144);
 static_assert(offsetof(BuildParams, levelOffset) == 148);
 static_assert(offsetof(BuildParams, levelCount) == 168);
 static_assert(offsetof(BuildParams, windingBeta) == 188);
+static_assert(offsetof(BuildParams, signMode) == 192);
 static_assert(sizeof(BuildParams) == 204);        // GLSL: last member (pad2) ends at 204
 inline constexpr size_t kBuildParamsBytes = 208;  // std140 rounds the block to 16 bytes
 
@@ -65,6 +67,14 @@ struct SamplePoint {
 };
 static_assert(sizeof(SamplePoint) == 16);
 
+// Binding 11 (std430): per triangle, object-space pseudo-normals of edges 0..2 (a-b, b-c, c-a)
+// then corners 0..2, xyz used.
+struct TrianglePseudoNormals {
+  glm::vec4 edge[3];
+  glm::vec4 corner[3];
+};
+static_assert(sizeof(TrianglePseudoNormals) == 96);
+
 // Push constants shared by every pass (each reads the members it declares).
 struct PushConstants {
   uint32_t a = 0;  // cluster: level; splat: mode; jfa/finalize: step
@@ -85,7 +95,8 @@ enum Binding : uint32_t {
   kValues = 8,
   kPoints = 9,
   kSamples = 10,
-  kBindingCount = 11,
+  kPseudoNormals = 11,
+  kBindingCount = 12,
 };
 
 }  // namespace sdfg::vk_layout

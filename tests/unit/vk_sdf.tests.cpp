@@ -223,6 +223,8 @@ void compareWithReference(const TriangleMesh& mesh, const SdfGrid& gpu,
 
   size_t nearCount = 0, signChecked = 0, badNear = 0, badFar = 0, badSign = 0;
   float worstNear = 0, worstFar = 0;
+  size_t worstNode = 0;
+  float worstGpu = 0, worstRef = 0;
   for (size_t i = 0; i < chosen.size(); ++i) {
     const float g = gpu.values()[chosen[i]], r = ref[i];
     const float err = std::abs(g - r);
@@ -231,7 +233,12 @@ void compareWithReference(const TriangleMesh& mesh, const SdfGrid& gpu,
       worstNear = std::max(worstNear, err);
       if (err > 0.1f * h) ++badNear;
     }
-    worstFar = std::max(worstFar, err);
+    if (err > worstFar) {
+      worstFar = err;
+      worstNode = chosen[i];
+      worstGpu = g;
+      worstRef = r;
+    }
     if (err > 0.5f * h) ++badFar;
     if (std::abs(r) > h) {
       ++signChecked;
@@ -240,7 +247,9 @@ void compareWithReference(const TriangleMesh& mesh, const SdfGrid& gpu,
   }
   INFO("resolution " << box.resolution.x << ", " << chosen.size() << " nodes checked, " << nearCount
                      << " near the surface, " << signChecked << " sign-checked; worst error near "
-                     << worstNear / h << " voxel, anywhere " << worstFar / h << " voxel");
+                     << worstNear / h << " voxel, anywhere " << worstFar / h << " voxel (node "
+                     << worstNode << ": gpu " << worstGpu / h << ", reference " << worstRef / h
+                     << " voxel)");
   CHECK(badNear == 0);
   CHECK(badFar == 0);
   CHECK(badSign == 0);

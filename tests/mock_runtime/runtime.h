@@ -6,12 +6,14 @@
 // objects below need no locks of their own.
 #pragma once
 
+// openxr_platform.h needs the Vulkan and timespec types declared first.
+#include <time.h>
+#include <vulkan/vulkan.h>
+
 #define XR_USE_GRAPHICS_API_VULKAN
 #define XR_USE_TIMESPEC
 #include <openxr/openxr.h>
 #include <openxr/openxr_platform.h>
-#include <time.h>
-#include <vulkan/vulkan.h>
 
 #include <array>
 #include <cstdint>

@@ -32,6 +32,10 @@ extern "C" {
 // Interaction profile of the simulated controllers (default /interaction_profiles/oculus/
 // touch_controller). The script directive "profile" overrides it.
 #define SDFG_MOCK_ENV_PROFILE "SDFG_MOCK_PROFILE"
+// One deliberate misbehaviour, so tests can prove their checks catch it:
+// "skip_layout_transition": swapchain images stay in VK_IMAGE_LAYOUT_UNDEFINED (the Vulkan
+// validation layer then reports the app's render pass).
+#define SDFG_MOCK_ENV_FAULT "SDFG_MOCK_FAULT"
 // "1": log every error the runtime returns, and why, on stderr.
 #define SDFG_MOCK_ENV_LOG "SDFG_MOCK_LOG"
 

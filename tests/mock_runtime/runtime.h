@@ -125,6 +125,7 @@ struct Options {
   std::string profile;          // simulated controller profile
   bool capture = false;
   std::string capturePath, reportPath;
+  std::string fault;  // SDFG_MOCK_FAULT: one deliberate misbehaviour, for negative tests
 };
 
 struct Instance final : Object {

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -26,17 +27,18 @@ namespace sdfg {
 class PhysicsCollider;  // solver_physics.h
 
 struct SolverOptions {
-  float da = 0.1f;              // curl step along each finger's curve, in (0, 1]
-  float threshold = -1.0f;      // stop distance in metres; < 0: each finger's tip radius
-  float refineStep = 0.01f;     // physics strategies: the fine step after the coarse one
+  float da = 0.1f;           // curl step along each finger's curve, in (0, 1]
+  float threshold = -1.0f;   // stop distance in metres; < 0: each finger's tip radius
+  float refineStep = 0.01f;  // physics strategies: the fine step after the coarse one
 };
 
 struct FingerState {
-  float curl = 0.0f;             // overall curl of the finger (its tip's curve parameter)
-  JointCurls jointCurls{};       // per joint; all equal to `curl` for single-curl strategies
-  bool contact = false;          // stopped on the surface (false: closed fully without touching)
-  glm::vec3 contactPoint{0.0f};  // hand space: where the finger touches (the stopping sphere's centre)
-  float distance = 0.0f;         // the target's distance at contactPoint as the strategy saw it
+  float curl = 0.0f;        // overall curl of the finger (its tip's curve parameter)
+  JointCurls jointCurls{};  // per joint; all equal to `curl` for single-curl strategies
+  bool contact = false;     // stopped on the surface (false: closed fully without touching)
+  glm::vec3 contactPoint{
+      0.0f};              // hand space: where the finger touches (the stopping sphere's centre)
+  float distance = 0.0f;  // the target's distance at contactPoint as the strategy saw it
 };
 
 struct GraspResult {
@@ -66,7 +68,14 @@ class GraspSolver {
   // Solves one grasp into `out`. Fails when not prepared or when the scene lacks what
   // needsField()/needsCollider() ask for. Never allocates for the SDF strategies.
   virtual Status solve(const GraspScene& scene, GraspResult& out) const = 0;
+
+  // Why the last prepare() failed, naming the option or input; empty after a successful one.
+  virtual std::string_view prepareError() const { return {}; }
 };
+
+// Checks the options every strategy shares: da and refineStep finite and in (0, 1], threshold
+// finite (negative means "the finger's tip radius"). Returns the first problem, or nothing.
+std::optional<Error> validateSolverOptions(const SolverOptions& options);
 
 // Names accepted by createSolver(), in the order the benchmark lists them.
 std::vector<std::string> solverNames();

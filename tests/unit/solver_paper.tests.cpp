@@ -259,19 +259,30 @@ TEST_CASE("paper solver handles no object, an object at the open hand and custom
     }
   }
   SECTION("a stop on the last sample gives a finite curl between 0.9 and 1") {
-    // A plane through the index tip at a = 1, facing the sample before it: only a = 1 is within
-    // the threshold (checked, since the curve's shape is the hand model's).
+    // The distance to the index tip's closed position, on a fine grid over the index curve:
+    // with a threshold of half the last segment, only a = 1 is within it (checked on the grid,
+    // since the curve's shape is the hand model's).
     const glm::vec3 end = hand.tipPosition(Finger::index, 1.0f);
-    const glm::vec3 before = hand.tipPosition(Finger::index, 0.9f);
-    const glm::vec3 n = glm::normalize(before - end);
-    const float threshold = 0.5f * glm::distance(before, end);
-    const auto plane = [&](const glm::vec3& p) { return glm::dot(p - end, n); };
-    for (int s = 0; s <= 9; ++s) {
-      REQUIRE(plane(hand.tipPosition(Finger::index, s / 10.0f)) >= threshold);
+    const float threshold = 0.5f * glm::distance(hand.tipPosition(Finger::index, 0.9f), end);
+    glm::vec3 lo(1e9f), hi(-1e9f);
+    for (int s = 0; s <= 100; ++s) {
+      lo = glm::min(lo, hand.tipPosition(Finger::index, s / 100.0f));
+      hi = glm::max(hi, hand.tipPosition(Finger::index, s / 100.0f));
     }
-    fillGrid(grid, plane);
+    GridBox tight;
+    tight.handFromBox.position = 0.5f * (lo + hi);
+    tight.size = hi - lo + 0.04f;
+    tight.resolution = glm::uvec3(96u);
+    SdfGrid point(tight);
+    fillGrid(point, [&](const glm::vec3& p) { return glm::distance(p, end); });
+    REQUIRE(point.sample(end) < threshold);
+    for (int s = 0; s <= 9; ++s) {
+      CAPTURE(s);
+      REQUIRE(point.sample(hand.tipPosition(Finger::index, s / 10.0f)) >= threshold);
+    }
     options.threshold = threshold;
-    REQUIRE(solver.prepare(hand, box, options) == Status::ok);
+    REQUIRE(solver.prepare(hand, tight, options) == Status::ok);
+    scene.field = &point;
     REQUIRE(solver.solve(scene, result) == Status::ok);
     const FingerState& index = result.fingers[int(Finger::index)];
     CHECK(index.contact);

@@ -77,7 +77,9 @@ class PhysicsCollider {
 // does), contact true, distance = Bullet's centre distance; no overlap up to a = 1 -> curl 1,
 // contact false, distance +infinity (the strategy only knows nothing was within the radius).
 // Tip positions come from HandModel::tipPosition at each tested curl, as Algorithm 1 blends
-// the pose per step.
+// the pose per step. Like Algorithm 1 it tests only tips at coarse steps, so a thin part can be
+// skipped between two steps, and with a mesh collider a step that lands the whole sphere inside
+// the object is not an overlap (the finger passes through).
 class PhysicsSolver final : public GraspSolver {
  public:
   explicit PhysicsSolver(PhysicsCollider::Kind kind) : kind_(kind) {}

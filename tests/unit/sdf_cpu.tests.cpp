@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <iostream>
 #include <random>
 
@@ -155,11 +156,13 @@ TEST_CASE("Timing of CPU grab-box builds on the armadillo", "[.][timing]") {
                            "stanford-bunny.obj"}) {
     const TriangleMesh* m = normalizedSharedMesh(name);
     if (m == nullptr) SDFG_SKIP("shared meshes missing");
+    const std::clock_t c0 = std::clock();
     const auto t0 = Clock::now();
     const auto d = makeDistance(*m);
     const auto t1 = Clock::now();
     std::cout << name << ": " << m->triangleCount() << " triangles, MeshDistance::create "
-              << ms(t1 - t0) << " ms\n";
+              << ms(t1 - t0) << " ms wall, " << 1000.0 * double(std::clock() - c0) / CLOCKS_PER_SEC
+              << " ms CPU\n";
     for (unsigned threads : {1u, 2u}) {
       CpuSdfBuilder builder(threads);
       for (uint32_t n : {16u, 32u, 64u}) {
@@ -168,16 +171,19 @@ TEST_CASE("Timing of CPU grab-box builds on the armadillo", "[.][timing]") {
         // Box centre on a surface point (hand pose = identity, so hand space = object space).
         box.handFromBox.position = m->positions[m->indices[3 * (m->triangleCount() / 3)]];
         SdfGrid grid;
-        double best = 1e30;
+        double best = 1e30, bestCpu = 1e30;
         for (int rep = 0; rep < 3; ++rep) {
+          // Process CPU time too: on a shared machine wall time counts other jobs' turns.
+          const std::clock_t c0 = std::clock();
           const auto s = Clock::now();
           REQUIRE(builder.build(*d, Pose{}, box, grid) == Status::ok);
           best = std::min(best, ms(Clock::now() - s));
+          bestCpu = std::min(bestCpu, 1000.0 * double(std::clock() - c0) / CLOCKS_PER_SEC);
         }
         CHECK(std::all_of(grid.values().begin(), grid.values().end(),
                           [](float v) { return std::isfinite(v); }));
-        std::cout << "  " << n << "^3, " << threads << " thread(s): " << best
-                  << " ms (best of 3)\n";
+        std::cout << "  " << n << "^3, " << threads << " thread(s): " << best << " ms wall, "
+                  << bestCpu << " ms CPU (best of 3)\n";
       }
     }
   }

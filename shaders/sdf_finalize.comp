@@ -19,6 +19,12 @@ layout(std430, set = 0, binding = 6) readonly buffer IdsA { uint idsA[]; };
 layout(std430, set = 0, binding = 7) readonly buffer IdsB { uint idsB[]; };
 // Binding 8: the signed distances, node-centred, values[i + Nx * (j + Ny * k)].
 layout(std430, set = 0, binding = 8) writeonly buffer Values { float values[]; };
+// Binding 5 (the splat's scratch, free by now): the values before sdf_repair, pseudo-normal mode.
+layout(std430, set = 0, binding = 5) writeonly buffer Unrepaired { float unrepaired[]; };
+
+void store(uint v, float value) {
+  if (P.signMode == 1u) unrepaired[v] = value; else values[v] = value;
+}
 
 // Binding 11: per triangle, object-space pseudo-normals of its edges 0..2 then corners 0..2
 // (equal-weight edge normals, angle-weighted vertex normals; Baerentzen & Aanaes 2005).
@@ -82,7 +88,7 @@ void main() {
   // No triangle within the cull margin: the surface is farther than the margin; spacing.w holds
   // the value to report (the margin), signed below like every other node.
   if (id == kNoTriangle) {
-    values[v] = P.signMode == 1u ? P.spacing.w : (windingNumber(p) > 0.5 ? -P.spacing.w : P.spacing.w);
+    store(v, P.signMode == 1u ? P.spacing.w : (windingNumber(p) > 0.5 ? -P.spacing.w : P.spacing.w));
     return;
   }
   vec3 a = tri[3u * id].xyz, b = tri[3u * id + 1u].xyz, c = tri[3u * id + 2u].xyz;
@@ -98,5 +104,5 @@ void main() {
   } else {
     inside = windingNumber(p) > 0.5;
   }
-  values[v] = inside ? -d : d;
+  store(v, inside ? -d : d);
 }

@@ -19,8 +19,18 @@ namespace L = vk_layout;
 
 namespace {
 
-enum Pass : uint32_t { kTransform, kCluster, kSplat, kJfa, kFinalize, kSample, kPassCount };
-constexpr uint32_t kTimestampCount = kPassCount + 1;  // before the first pass and after each
+enum Pass : uint32_t {
+  kTransform,
+  kCluster,
+  kSplat,
+  kJfa,
+  kFinalize,
+  kRepair,
+  kSample,
+  kPassCount
+};
+// Timestamps: start, then after transform, hierarchy, splat, flood, finalize (+ repair), sample.
+constexpr uint32_t kTimestampCount = 7;
 
 // Buffers the builder owns, by role.
 enum Slot : uint32_t {
@@ -239,8 +249,8 @@ Result<std::unique_ptr<VkSdfBuilder>> VkSdfBuilder::create(const VulkanDevice& d
   o.pipelineLayout = VkOwned<VkPipelineLayout>(c, pipelineLayout);
 
   const std::array<std::span<const uint32_t>, kPassCount> code = {
-      spirv::k_sdf_transform, spirv::k_sdf_cluster,  spirv::k_sdf_splat,
-      spirv::k_sdf_jfa,       spirv::k_sdf_finalize, spirv::k_sdf_sample};
+      spirv::k_sdf_transform, spirv::k_sdf_cluster, spirv::k_sdf_splat, spirv::k_sdf_jfa,
+      spirv::k_sdf_finalize,  spirv::k_sdf_repair,  spirv::k_sdf_sample};
   const VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};  // constant_id 0: local_size_x
   const uint32_t groupSize = b->workGroupSize_;
   const VkSpecializationInfo spec{1, &entry, sizeof(uint32_t), &groupSize};
@@ -732,6 +742,11 @@ Status VkSdfBuilder::record(bool build, size_t pointCount, bool readBack) {
     }
     stamp(4);
     dispatch(kFinalize, nodeCount, {0, flip});
+    if (pseudoNormalSign_) {
+      // The unrepaired values are written before the repair pass reads them.
+      computeToCompute();
+      dispatch(kRepair, nodeCount, {});
+    }
     // The SDF is written before sampling and the host copy read it.
     barrier(kCompute, kWrite, kCompute | kTransfer, kRead | VK_ACCESS_TRANSFER_READ_BIT);
     stamp(5);

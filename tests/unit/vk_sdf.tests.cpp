@@ -16,8 +16,11 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "mesh.h"
+#include "mesh_distance.h"
+#include "sdf_cpu.h"
 #include "sdf_grid.h"
 #include "test_support.h"
+#include "vk_sdf_backend.h"
 #include "vk_sdf_builder.h"
 #include "vk_standalone.h"
 
@@ -256,6 +259,36 @@ void compareWithReference(const TriangleMesh& mesh, const SdfGrid& gpu,
   CHECK(nearCount > 0);
 }
 
+// Compares every node of the GPU grid with the CPU builder's (the project's reference: BVH
+// closest point, pseudo-normal sign on closed meshes, fast winding number on open ones).
+void compareWithCpuBuilder(const SdfGrid& gpu, const SdfGrid& cpu) {
+  const float h = gpu.box().maxSpacing();
+  size_t nearCount = 0, signChecked = 0, badNear = 0, badFar = 0, badSign = 0;
+  float worstNear = 0, worstFar = 0;
+  for (size_t v = 0; v < gpu.values().size(); ++v) {
+    const float g = gpu.values()[v], r = cpu.values()[v];
+    const float err = std::abs(g - r);
+    if (std::abs(r) < h) {
+      ++nearCount;
+      worstNear = std::max(worstNear, err);
+      if (err > 0.1f * h) ++badNear;
+    }
+    worstFar = std::max(worstFar, err);
+    if (err > 0.5f * h) ++badFar;
+    if (std::abs(r) > h) {
+      ++signChecked;
+      if ((g < 0) != (r < 0)) ++badSign;
+    }
+  }
+  INFO("resolution " << gpu.box().resolution.x << ": every node, " << nearCount
+                     << " near the surface, " << signChecked << " sign-checked; worst error near "
+                     << worstNear / h << " voxel, anywhere " << worstFar / h << " voxel");
+  CHECK(badNear == 0);
+  CHECK(badFar == 0);
+  CHECK(badSign == 0);
+  CHECK(nearCount > 0);
+}
+
 void checkMesh(const std::string& file) {
   REQUIRE_DEVICE(vk);
   const auto mesh = sharedTestMesh(file);
@@ -263,10 +296,15 @@ void checkMesh(const std::string& file) {
   auto builder = VkSdfBuilder::create(vk->device());
   REQUIRE(builder.ok());
   REQUIRE((*builder)->setMesh(*mesh) == Status::ok);
+  auto distance = MeshDistance::create(*mesh);
+  REQUIRE(distance.ok());
+  CpuSdfBuilder cpuBuilder;
   for (uint32_t n : {16u, 32u, 64u}) {
     CAPTURE(file, n);
     const SdfGrid gpu = buildOnGpu(**builder, testBox(n), testObjectFromHand());
-    compareWithReference(*mesh, gpu, testObjectFromHand());
+    SdfGrid cpu;
+    REQUIRE(cpuBuilder.build(**distance, testObjectFromHand(), testBox(n), cpu) == Status::ok);
+    compareWithCpuBuilder(gpu, cpu);
   }
   CHECK(vk->messageCount() == 0);
 }
@@ -546,6 +584,46 @@ TEST_CASE("Vulkan SDF builder refuses bad input and survives a lost device", "[g
     CHECK(b.submitBuild(testBox(16), Pose{}, {}) == Status::device_lost);
     CHECK(b.setMesh(localTorus(0.05f, 0.018f, 8, 6)) == Status::device_lost);
     CHECK(b.failed());
+    CHECK(log.size() == 1);
+  }
+  CHECK(vk->messageCount() == 0);
+}
+
+TEST_CASE("GrabBoxSdf redoes a request on the CPU when the device is lost", "[gpu][vk_sdf]") {
+  REQUIRE_DEVICE(vk);
+  std::vector<std::string> log;
+  VkSdfOptions options;
+  options.log = [&](const std::string& line) { log.push_back(line); };
+  const VulkanDevice device = vk->device();
+  auto sdf = GrabBoxSdf::create(&device, options);
+  REQUIRE(sdf->backend() == SdfBackendKind::vulkan);
+  const TriangleMesh torus = localTorus(0.05f, 0.018f, 24, 12);
+  REQUIRE(sdf->setMesh(torus) == Status::ok);
+  const std::vector<glm::vec3> points = {{0.5f, 0.5f, 0.5f}, {0.1f, 0.9f, 0.3f}};
+
+  auto cpuOnly = GrabBoxSdf::create(nullptr);
+  REQUIRE(cpuOnly->backend() == SdfBackendKind::cpu);
+  REQUIRE(cpuOnly->setMesh(torus) == Status::ok);
+  REQUIRE(cpuOnly->submit(testBox(16), testObjectFromHand(), points) == Status::ok);
+  REQUIRE(cpuOnly->poll() == SdfPoll::ready);
+  const std::vector<float> expected(cpuOnly->samples().begin(), cpuOnly->samples().end());
+
+  SECTION("a working device gives the CPU path's values") {
+    REQUIRE(sdf->submit(testBox(16), testObjectFromHand(), points) == Status::ok);
+    REQUIRE(sdf->wait(10'000'000'000ull) == SdfPoll::ready);
+    for (size_t i = 0; i < points.size(); ++i) {
+      CHECK(sdf->samples()[i] == Approx(expected[i]).margin(0.05f * testBox(16).maxSpacing()));
+    }
+  }
+  SECTION("results equal the CPU path after a loss") {
+    auto lost = GrabBoxSdf::create(&device, options);
+    REQUIRE(lost->setMesh(torus) == Status::ok);
+    lost->simulateDeviceLostForTesting();
+    CHECK(lost->submit(testBox(16), testObjectFromHand(), points) == Status::ok);
+    CHECK(lost->poll() == SdfPoll::ready);
+    CHECK(lost->backend() == SdfBackendKind::cpu);
+    REQUIRE(lost->samples().size() == points.size());
+    for (size_t i = 0; i < points.size(); ++i) CHECK(lost->samples()[i] == expected[i]);
     CHECK(log.size() == 1);
   }
   CHECK(vk->messageCount() == 0);

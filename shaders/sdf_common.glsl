@@ -8,8 +8,10 @@
 // Work-group size from the host (clamped to the device limits); 64 when not specialized.
 layout(local_size_x_id = 0) in;
 
-// Binding 0: per-build parameters (host-visible, written before each submission).
-layout(std140, set = 0, binding = 0) uniform BuildParams {
+// Binding 0: per-build parameters (host-visible, written before each submission). A storage
+// buffer, not a uniform block: Mesa's lavapipe inlines uniform values into a recompiled shader
+// variant and kept every variant, growing by ~230 KB per build (Mesa 22.3).
+layout(std430, set = 0, binding = 0) readonly buffer BuildParams {
   mat4 boxFromObject;   // mesh space -> box space (rigid)
   vec4 boxHalf;         // xyz: size / 2; w: cull margin (metres)
   vec4 spacing;         // xyz: node spacing; w: distance written where no triangle is known

@@ -35,17 +35,18 @@ bool fetchPosition(uint v, out vec3 p) {
 void main() {
   uint t = gl_GlobalInvocationID.x;
   if (t >= P.triangleCount) return;  // the dispatch is rounded up to whole groups
-  vec3 q[3];
-  bool valid = true;
-  for (uint c = 0u; c < 3u; ++c) {
-    vec3 pm;
-    valid = fetchPosition(fetchIndex(3u * t + c), pm) && valid;
-    q[c] = (P.boxFromObject * vec4(pm, 1.0)).xyz;
-  }
+  vec3 p0, p1, p2;
+  bool valid = fetchPosition(fetchIndex(3u * t), p0);
+  valid = fetchPosition(fetchIndex(3u * t + 1u), p1) && valid;
+  valid = fetchPosition(fetchIndex(3u * t + 2u), p2) && valid;
+  vec3 q0 = (P.boxFromObject * vec4(p0, 1.0)).xyz;
+  vec3 q1 = (P.boxFromObject * vec4(p1, 1.0)).xyz;
+  vec3 q2 = (P.boxFromObject * vec4(p2, 1.0)).xyz;
   // A triangle with a bad index or a non-finite corner is dropped (a.w = -1): it neither seeds
   // the distance nor adds to the winding number, and reads stay in bounds.
-  for (uint c = 0u; c < 3u; ++c) {
-    if (any(isnan(q[c])) || any(isinf(q[c]))) valid = false;
+  vec3 sum = q0 + q1 + q2;
+  if (any(isnan(sum)) || any(isinf(sum)) || any(isnan(q0)) || any(isnan(q1)) || any(isnan(q2))) {
+    valid = false;
   }
   if (!valid) {
     tri[3u * t] = vec4(0.0, 0.0, 0.0, -1.0);
@@ -53,11 +54,11 @@ void main() {
     tri[3u * t + 2u] = vec4(0.0);
     return;
   }
-  vec3 lo = min(q[0], min(q[1], q[2]));
-  vec3 hi = max(q[0], max(q[1], q[2]));
+  vec3 lo = min(q0, min(q1, q2));
+  vec3 hi = max(q0, max(q1, q2));
   vec3 reach = P.boxHalf.xyz + vec3(P.boxHalf.w);
   bool inside = valid && all(lessThanEqual(lo, reach)) && all(greaterThanEqual(hi, -reach));
-  tri[3u * t] = vec4(q[0], inside ? 1.0 : 0.0);
-  tri[3u * t + 1u] = vec4(q[1], 0.0);
-  tri[3u * t + 2u] = vec4(q[2], 0.0);
+  tri[3u * t] = vec4(q0, inside ? 1.0 : 0.0);
+  tri[3u * t + 1u] = vec4(q1, 0.0);
+  tri[3u * t + 2u] = vec4(q2, 0.0);
 }

@@ -220,8 +220,7 @@ Result<std::unique_ptr<VkSdfBuilder>> VkSdfBuilder::create(const VulkanDevice& d
   std::array<VkDescriptorSetLayoutBinding, L::kBindingCount> bindings{};
   for (uint32_t i = 0; i < L::kBindingCount; ++i) {
     bindings[i].binding = i;
-    bindings[i].descriptorType =
-        i == L::kParams ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     bindings[i].descriptorCount = 1;
     bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
   }
@@ -280,9 +279,8 @@ Result<std::unique_ptr<VkSdfBuilder>> VkSdfBuilder::create(const VulkanDevice& d
     o.pipelines[p] = VkOwned<VkPipeline>(c, pipeline);
   }
 
-  const std::array<VkDescriptorPoolSize, 2> poolSizes = {
-      VkDescriptorPoolSize{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
-      VkDescriptorPoolSize{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, L::kBindingCount - 1}};
+  const std::array<VkDescriptorPoolSize, 1> poolSizes = {
+      VkDescriptorPoolSize{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, L::kBindingCount}};
   auto poolInfo =
       vkStruct<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
   poolInfo.maxSets = 1;
@@ -416,10 +414,9 @@ Status VkSdfBuilder::ensureBuffer(uint32_t slot, size_t bytes, uint32_t kind) {
   if (b.buffer && b.size >= bytes) return Status::ok;
   // Grow by half again so a slowly growing mesh or point count does not reallocate each time.
   const size_t size = b.buffer ? std::max(bytes, size_t(b.size) + size_t(b.size) / 2) : bytes;
-  const VkBufferUsageFlags usage = slot == kParamsBuf ? VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
-                                                      : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                                            VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                                            VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                   VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   b = VkBufferAlloc{};  // frees the old one first (nothing is in flight: checked by callers)
   auto created = createBuffer(*ctx_, size, usage, memoryKind(kind));
   if (!created) return fail(created.error());
@@ -464,8 +461,7 @@ void VkSdfBuilder::updateDescriptors() {
     writes[i].dstSet = objects_->set;
     writes[i].dstBinding = i;
     writes[i].descriptorCount = 1;
-    writes[i].descriptorType =
-        i == L::kParams ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     writes[i].pBufferInfo = &infos[i];
   }
   ctx_->fn().vkUpdateDescriptorSets(ctx_->handle(), L::kBindingCount, writes.data(), 0, nullptr);

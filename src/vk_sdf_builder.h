@@ -9,10 +9,11 @@
 // every other node, each keeping the candidate at the smallest exact distance; the final value
 // is the exact distance to that triangle. The sign follows the CPU builder: on a closed,
 // consistently oriented mesh given as arrays, the angle-weighted pseudo-normal of the closest
-// feature (computed on the CPU at setMesh); otherwise (open meshes, the app's buffers) the
-// generalized winding number (> 0.5 inside), summed over a 32-ary hierarchy of triangle clusters
-// with a dipole far field. It needs no adjacency, so skinned meshes in app buffers work as they
-// are, at a higher cost.
+// feature (computed on the CPU at setMesh), with far nodes taking the majority sign of their
+// face neighbours so that a flooded id from the back of a thin part cannot flip one; otherwise
+// (open meshes, the app's buffers) the generalized winding number (> 0.5 inside), summed over a
+// 32-ary hierarchy of triangle clusters with a dipole far field. It needs no adjacency, so skinned
+// meshes in app buffers work as they are, at a higher cost.
 //
 // Frame path: submit*() records and submits one command buffer and returns at once; poll()
 // checks the fence without waiting. One submission is in flight at a time. Every Vulkan object

@@ -1,6 +1,6 @@
 // Host mirrors of the structs the SDF compute shaders read and write (shaders/sdf_common.glsl and
-// the pass files). Each is checked field for field against the GLSL layout rules (std140 for the
-// uniform block, std430 for storage buffers), so a change on one side fails to compile here.
+// the pass files). Each is checked field for field against the GLSL std430 layout rules, so a
+// change on one side fails to compile here.
 #pragma once
 
 #include <cstddef>
@@ -15,7 +15,8 @@ inline constexpr uint32_t kFanOut = 32;    // children per winding-hierarchy nod
 inline constexpr uint32_t kMaxLevels = 5;  // levels the shaders address (levelOffset0..4)
 inline constexpr uint32_t kNoTriangle = 0xffffffffu;
 
-// Binding 0 (uniform, std140): per-build parameters. See BuildParams in sdf_common.glsl.
+// Binding 0 (std430, read-only storage buffer): per-build parameters. See BuildParams in
+// sdf_common.glsl.
 struct BuildParams {
   glm::mat4 boxFromObject;  // column-major, like GLSL's mat4
   glm::vec4 boxHalf;        // xyz: size / 2; w: cull margin
@@ -46,7 +47,7 @@ static_assert(offsetof(BuildParams, levelCount) == 168);
 static_assert(offsetof(BuildParams, windingBeta) == 188);
 static_assert(offsetof(BuildParams, signMode) == 192);
 static_assert(sizeof(BuildParams) == 204);        // GLSL: last member (pad2) ends at 204
-inline constexpr size_t kBuildParamsBytes = 208;  // std140 rounds the block to 16 bytes
+inline constexpr size_t kBuildParamsBytes = 208;  // the block aligns to its mat4: 16 bytes
 
 // Binding 3 (std430): one triangle in box space, three vec4 (a.w = cull flag).
 struct BoxTriangle {

@@ -41,12 +41,16 @@ void main() {
         uint v = i + P.res.x * (j + P.res.y * k);
         vec3 p = nodePosition(uvec3(i, j, k));
         float d = length(p - closestOnTriangle(p, a, b, c));
-        // Beyond two spacings a seed adds nothing the flood would not find: skip the atomic.
+        // Beyond two spacings a seed adds little the flood would not find: skip the atomic. (One
+        // spacing is enough for exact values near the surface, but the thinner seed shell let
+        // the flood hand more far nodes the back of a thin part: sign errors on the armadillo.)
         // (Nodes of the boundary layer seeded for triangles outside the box are always kept.)
         if (d > seedReach && !outside) continue;
         uint bits = floatBitsToUint(d);
         if (pc.mode == 0u) {
-          atomicMin(distBits[v], bits);
+          // A plain read first: most candidates lose, and atomics are costly under contention
+          // (many small triangles per node). A stale read only costs an unneeded atomic.
+          if (bits < distBits[v]) atomicMin(distBits[v], bits);
         } else if (distBits[v] == bits) {
           idsA[v] = t;
         }

@@ -101,8 +101,13 @@ void ExactMeshQuery::signedDistances(std::span<const glm::vec3> points,
                                      std::span<double> out) const {
   bool previousInside = false;
   double previousDistance = 0.0;
+  Point3 hint;
   for (size_t i = 0; i < points.size() && i < out.size(); ++i) {
-    const double d = unsignedDistance(points[i]);
+    const Point3 p = toPoint(points[i]);
+    // The previous point's closest point starts the search with a sphere barely larger than the
+    // answer, instead of the tree's own nearest-vertex guess.
+    hint = i == 0 ? impl_->tree.closest_point(p) : impl_->tree.closest_point(p, hint);
+    const double d = std::sqrt(CGAL::squared_distance(p, hint));
     bool isInside;
     // No surface lies within previousDistance of the previous point, so a step shorter than
     // that cannot have crossed it.

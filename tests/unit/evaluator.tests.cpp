@@ -92,6 +92,36 @@ TEST_CASE("Exact signed distance matches a box and a sphere analytically", "[cor
     q->signedDistances(chain, d);
     for (size_t i = 0; i < chain.size(); ++i) CHECK(d[i] == Approx(q->signedDistance(chain[i])));
   }
+  SECTION("Inside stays right on a sphere with a small hole (open mesh)") {
+    TriangleMesh open = makeSphere(0.05f, 3);
+    // Drop the triangles around the +Y pole: a hole like the bunny's base.
+    std::vector<uint32_t> kept;
+    size_t dropped = 0;
+    for (size_t t = 0; t < open.triangleCount(); ++t) {
+      const glm::vec3 c =
+          (open.positions[open.indices[3 * t]] + open.positions[open.indices[3 * t + 1]] +
+           open.positions[open.indices[3 * t + 2]]) /
+          3.0f;
+      if (c.y > 0.048f) {
+        ++dropped;
+        continue;
+      }
+      kept.insert(kept.end(), &open.indices[3 * t], &open.indices[3 * t] + 3);
+    }
+    REQUIRE(dropped > 0);
+    REQUIRE(dropped < 20);
+    open.indices = kept;
+    auto q = queryOf(open);
+    int wrong = 0;
+    for (int i = 0; i < 100; ++i) {
+      const float t = float(i) * 0.61803398875f;
+      const glm::vec3 dir = glm::normalize(
+          glm::vec3(std::sin(t * 7.1f), std::cos(t * 3.3f), std::sin(t * 1.7f + 0.4f)));
+      wrong += q->inside(dir * 0.03f) ? 0 : 1;
+      wrong += q->inside(dir * 0.07f) ? 1 : 0;
+    }
+    CHECK(wrong == 0);
+  }
   SECTION("An invalid mesh is an error, not a crash") {
     TriangleMesh bad;
     bad.positions = {glm::vec3(0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0)};

@@ -37,10 +37,7 @@
 #include "sdf_grid.h"
 #include "shapes.h"
 #include "solver.h"
-#if __has_include("solver_physics.h")
 #include "solver_physics.h"
-#define SDFG_HAVE_PHYSICS 1
-#endif
 
 namespace fs = std::filesystem;
 using namespace sdfg;
@@ -262,7 +259,6 @@ std::vector<fs::path> defaultMeshFiles(const fs::path& dir) {
 // ---------------------------------------------------------------------------------------------
 // Running one mesh
 
-#ifdef SDFG_HAVE_PHYSICS
 using ColliderPtr = std::unique_ptr<PhysicsCollider>;
 // The physics strategies do not say which collider they read; their names do.
 Result<ColliderPtr> makeColliderFor(std::string_view method, const TriangleMesh& mesh) {
@@ -271,13 +267,6 @@ Result<ColliderPtr> makeColliderFor(std::string_view method, const TriangleMesh&
                         : PhysicsCollider::Kind::triangleMesh;
   return PhysicsCollider::create(mesh, kind);
 }
-#else
-struct NoCollider {};
-using ColliderPtr = std::unique_ptr<NoCollider>;
-Result<ColliderPtr> makeColliderFor(std::string_view method, const TriangleMesh&) {
-  return makeError(Status::unsupported, std::string(method) + ": built without solver_physics.h");
-}
-#endif
 
 struct Progress {
   bool enabled = isatty(STDERR_FILENO) != 0;
@@ -363,7 +352,7 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
     auto solver = createSolver(m);
     if (!solver) return solver.error();
     if (Status s = (*solver)->prepare(hand, box, solverOptions); s != Status::ok) {
-      return makeError(s, m + ": prepare failed (" + std::string(toString(s)) + ")");
+      return makeError(s, m + ": prepare failed: " + std::string((*solver)->prepareError()));
     }
     Method method{m, std::move(*solver), nullptr};
     if (method.solver->needsCollider()) {
@@ -414,9 +403,7 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
       scene.field = &grid;
     }
     for (size_t m = 0; m < methods.size(); ++m) {
-#ifdef SDFG_HAVE_PHYSICS
       scene.collider = methods[m].collider.get();
-#endif
       Status s = Status::ok;
       const double us = timeSolveUs(*methods[m].solver, scene, results[m][p], s, now);
       if (s != Status::ok) {

@@ -74,11 +74,19 @@ Result<std::unique_ptr<ExactMeshQuery>> ExactMeshQuery::create(const TriangleMes
   return std::unique_ptr<ExactMeshQuery>(new ExactMeshQuery(std::move(impl)));
 }
 
+namespace {
+bool allFinite(const glm::vec3& p) {
+  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+}
+}  // namespace
+
 double ExactMeshQuery::unsignedDistance(const glm::vec3& p) const {
+  if (!allFinite(p)) return std::numeric_limits<double>::quiet_NaN();
   return std::sqrt(impl_->tree.squared_distance(toPoint(p)));
 }
 
 bool ExactMeshQuery::inside(const glm::vec3& p) const {
+  if (!allFinite(p)) return false;
   const Point3 origin = toPoint(p);
   constexpr int kMajority = kInsideRays / 2 + 1;
   int in = 0, out = 0;
@@ -102,11 +110,18 @@ void ExactMeshQuery::signedDistances(std::span<const glm::vec3> points,
   bool previousInside = false;
   double previousDistance = 0.0;
   Point3 hint;
+  bool haveHint = false;
   for (size_t i = 0; i < points.size() && i < out.size(); ++i) {
+    if (!allFinite(points[i])) {
+      out[i] = std::numeric_limits<double>::quiet_NaN();
+      previousDistance = 0.0;  // the next point casts its own rays
+      continue;
+    }
     const Point3 p = toPoint(points[i]);
     // The previous point's closest point starts the search with a sphere barely larger than the
     // answer, instead of the tree's own nearest-vertex guess.
-    hint = i == 0 ? impl_->tree.closest_point(p) : impl_->tree.closest_point(p, hint);
+    hint = !haveHint ? impl_->tree.closest_point(p) : impl_->tree.closest_point(p, hint);
+    haveHint = true;
     const double d = std::sqrt(CGAL::squared_distance(p, hint));
     bool isInside;
     // No surface lies within previousDistance of the previous point, so a step shorter than
@@ -180,6 +195,16 @@ ChainMeasure measureChain(const ExactMeshQuery& mesh, const FingerChain& chain,
 GraspMetrics evaluateGrasp(const ExactMeshQuery& mesh, const HandModel& hand,
                            const Pose& objectFromHand, const GraspResult& grasp) {
   GraspMetrics out;
+  const glm::quat& q = objectFromHand.orientation;
+  if (!allFinite(objectFromHand.position) || !std::isfinite(q.w) ||
+      !allFinite(glm::vec3(q.x, q.y, q.z))) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (FingerMetrics& f : out.fingers) {
+      f.tipDistanceMm = f.tipGapMm = f.tipResidualMm = f.penetrationMm = f.clearanceMm = nan;
+    }
+    out.penetrationMm = nan;
+    return out;
+  }
   FingerChain chain;
   std::vector<double> scratch;
   for (int f = 0; f < kFingerCount; ++f) {
@@ -188,7 +213,10 @@ GraspMetrics evaluateGrasp(const ExactMeshQuery& mesh, const HandModel& hand,
     const double tipRadius = hand.tipRadius(finger);
     FingerMetrics& m = out.fingers[f];
 
-    sampleFinger(hand, finger, state.jointCurls, objectFromHand, chain);
+    // Curls outside [0, 1] or NaN (a broken solver) are graded as the pose they clamp to.
+    JointCurls stopCurls = state.jointCurls;
+    for (float& c : stopCurls) c = std::isfinite(c) ? std::clamp(c, 0.0f, 1.0f) : 0.0f;
+    sampleFinger(hand, finger, stopCurls, objectFromHand, chain);
     const ChainMeasure at = measureChain(mesh, chain, scratch);
     m.contact = state.contact;
     m.stopped = state.contact || state.curl < 1.0f - 1e-6f;
@@ -200,11 +228,11 @@ GraspMetrics evaluateGrasp(const ExactMeshQuery& mesh, const HandModel& hand,
     m.touching = m.clearanceMm <= kTouchingMm;
 
     if (m.stopped && m.tipGapMm > kEarlyStopGapMm) {
-      JointCurls curls = state.jointCurls;
+      JointCurls curls = stopCurls;
       for (int step = 1;; ++step) {
         bool allClosed = true;
         for (size_t j = 0; j < curls.size(); ++j) {
-          curls[j] = std::min(1.0f, state.jointCurls[j] + kEarlyStopSweepStep * float(step));
+          curls[j] = std::min(1.0f, stopCurls[j] + kEarlyStopSweepStep * float(step));
           allClosed = allClosed && curls[j] >= 1.0f;
         }
         sampleFinger(hand, finger, curls, objectFromHand, chain);

@@ -85,7 +85,8 @@ struct GraspMetrics {
   int earlyStops = 0;
 };
 
-// Metrics of one grasp. `objectFromHand` is the placement the solver saw; the finger poses come
+// Metrics of one grasp. `objectFromHand` is the placement the solver saw (non-finite: every
+// float metric is NaN); curls are clamped to [0, 1], NaN read as 0; the finger poses come
 // from hand.fingerPose() at each finger's final jointCurls. Penetration is measured on capsules
 // from the proximal joint to the tip (joint radii, linearly interpolated along each bone), sampled
 // every kCapsuleSampleSpacing. Early stop: for a stopped finger with a tip gap > 5 mm, every joint

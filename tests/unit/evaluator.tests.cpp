@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -200,6 +201,18 @@ TEST_CASE("Grasp metrics report penetration, residual and early stops", "[core][
     const GraspMetrics atPlane = evaluateGrasp(*q, hand, identity, g);
     CHECK_FALSE(atPlane.fingers[int(index)].earlyStop);
     CHECK(atPlane.fingers[int(index)].tipGapMm <= kEarlyStopGapMm);
+  }
+  SECTION("Non-finite input gives NaN metrics, not a crash") {
+    auto q = queryOf(makeBox(glm::vec3(0.05f)));
+    CHECK(std::isnan(q->signedDistance(glm::vec3(std::nanf(""), 0.0f, 0.0f))));
+    Pose broken;
+    broken.position.x = std::numeric_limits<float>::infinity();
+    const GraspMetrics m = evaluateGrasp(*q, hand, broken, allAt(0.5f));
+    CHECK(std::isnan(m.penetrationMm));
+    GraspResult nanCurls = allAt(std::nanf(""));
+    const GraspMetrics clamped =
+        evaluateGrasp(*q, hand, Pose{glm::quat(1, 0, 0, 0), glm::vec3(0, 1, 0)}, nanCurls);
+    CHECK(std::isfinite(clamped.penetrationMm));
   }
   SECTION("A finger far from anything it could reach is not an early stop") {
     auto q = queryOf(sphereAt(glm::vec3(0.0f, 0.5f, 0.0f), 0.02f));  // behind the back of the hand

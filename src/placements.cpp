@@ -67,7 +67,11 @@ bool openHandIntersects(const ExactMeshQuery& query, const HandModel& hand,
 
 std::vector<Placement> generatePlacements(const TriangleMesh& normalizedMesh,
                                           const ExactMeshQuery& query, const HandModel& hand,
-                                          const GridBox& box, int count, uint64_t seed) {
+                                          const GridBox& box, int count, uint64_t seed,
+                                          PlacementStats* stats) {
+  PlacementStats local;
+  PlacementStats& st = stats ? *stats : local;
+  st = PlacementStats{};
   std::vector<Placement> out;
   const size_t triangles = normalizedMesh.triangleCount();
   if (count <= 0 || triangles == 0) return out;
@@ -92,6 +96,7 @@ std::vector<Placement> generatePlacements(const TriangleMesh& normalizedMesh,
   std::mt19937_64 rng(seed);
   const long long maxAttempts = (long long)kPlacementAttemptsPerPlacement * count;
   for (long long attempt = 0; attempt < maxAttempts && int(out.size()) < count; ++attempt) {
+    ++st.attempts;
     const double uTriangle = uniform01(rng());
     const double u1 = uniform01(rng());
     const double u2 = uniform01(rng());
@@ -128,9 +133,13 @@ std::vector<Placement> generatePlacements(const TriangleMesh& normalizedMesh,
     const glm::vec3 uvw = box.handToNormalized(objectFromHand.inverse().transformPoint(point));
     if (glm::any(glm::lessThan(uvw, glm::vec3(0.0f))) ||
         glm::any(glm::greaterThan(uvw, glm::vec3(1.0f)))) {
+      ++st.outsideBox;
       continue;
     }
-    if (openHandIntersects(query, hand, objectFromHand)) continue;
+    if (openHandIntersects(query, hand, objectFromHand)) {
+      ++st.handIntersecting;
+      continue;
+    }
     out.push_back(Placement{objectFromHand, point, n, distance});
   }
   return out;

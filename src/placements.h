@@ -43,10 +43,17 @@ inline constexpr int kPlacementAttemptsPerPlacement = 200;
 //    radius.
 // Returns fewer than `count` placements only when kPlacementAttemptsPerPlacement * count attempts
 // did not find enough (a mesh with no room for an open hand); callers check size(). count <= 0
-// gives an empty vector.
+// gives an empty vector. `stats`, when given, receives how many attempts were drawn and why
+// rejected ones were.
+struct PlacementStats {
+  long long attempts = 0;
+  long long outsideBox = 0;        // rejected: surface point outside the grab box
+  long long handIntersecting = 0;  // rejected: the open hand touches or enters the mesh
+};
 std::vector<Placement> generatePlacements(const TriangleMesh& normalizedMesh,
                                           const ExactMeshQuery& query, const HandModel& hand,
-                                          const GridBox& box, int count, uint64_t seed);
+                                          const GridBox& box, int count, uint64_t seed,
+                                          PlacementStats* stats = nullptr);
 
 // Whether the open hand at `objectFromHand` touches or enters the mesh (the rejection test above,
 // without the box).

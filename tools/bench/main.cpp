@@ -366,8 +366,14 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
 
   auto now = [] { return std::chrono::steady_clock::now(); };
   const auto startedAt = now();
+  PlacementStats placementStats;
   const std::vector<Placement> placements =
-      generatePlacements(mesh, **exact, hand, box, o.placements, o.seed);
+      generatePlacements(mesh, **exact, hand, box, o.placements, o.seed, &placementStats);
+  std::fprintf(stderr,
+               "%s: %zu placements from %lld attempts (%lld outside the box, %lld with the open "
+               "hand touching the mesh)\n",
+               name.c_str(), placements.size(), placementStats.attempts, placementStats.outsideBox,
+               placementStats.handIntersecting);
   if (placements.size() < size_t(o.placements)) {
     std::fprintf(stderr, "%s: only %zu of %d placements found room for an open hand\n",
                  name.c_str(), placements.size(), o.placements);

@@ -237,8 +237,11 @@ TEST_CASE("Placements are seeded, counted and put the palm over the surface",
   const std::vector<Placement> b = generatePlacements(mesh, *q, hand, box, count, 7);
   const std::vector<Placement> c = generatePlacements(mesh, *q, hand, box, count, 8);
 
-  SECTION("The count is honoured") {
+  SECTION("The count is honoured and every attempt is accounted for") {
     CHECK(a.size() == size_t(count));
+    PlacementStats stats;
+    CHECK(generatePlacements(mesh, *q, hand, box, count, 7, &stats).size() == size_t(count));
+    CHECK(stats.attempts == count + stats.outsideBox + stats.handIntersecting);
     CHECK(c.size() == size_t(count));
     CHECK(generatePlacements(mesh, *q, hand, box, 0, 7).empty());
   }

@@ -386,7 +386,7 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
     rows[m].method = methods[m].name;
     rows[m].usesField = methods[m].solver->needsField();
   }
-  // results[m][p]; ok[m][p] says whether the solve succeeded.
+  // results[m][p]; solved[m][p] says whether the solve succeeded.
   std::vector<std::vector<GraspResult>> results(methods.size(),
                                                 std::vector<GraspResult>(placements.size()));
   std::vector<std::vector<char>> solved(methods.size(), std::vector<char>(placements.size(), 0));

@@ -57,6 +57,65 @@ struct OursSolver::Eval {
   glm::vec3 point{0.0f};  // hand space (corrected frame)
 };
 
+namespace {
+
+// Trilinear sampling as SdfGrid::sampleNormalized, with the floor done by an integer cast (the
+// coordinate is clamped to be non-negative) so the hot loop makes no library call.
+struct FastSampler {
+  const float* v = nullptr;
+  glm::ivec3 n{2};
+  glm::vec3 scale{1.0f};
+  size_t sy = 0, sz = 0;
+
+  explicit FastSampler(const SdfGrid& grid)
+      : v(grid.values().data()),
+        n(grid.box().resolution),
+        scale(glm::vec3(grid.box().resolution) - 1.0f),
+        sy(size_t(n.x)),
+        sz(size_t(n.x) * size_t(n.y)) {}
+
+  static void locate(float u, float s, int n, int& i, float& t) {
+    const float x = std::clamp(u, 0.0f, 1.0f) * s;
+    i = std::min(int(x), n - 2);
+    t = x - float(i);
+  }
+  float operator()(const glm::vec3& uvw) const {
+    int i, j, k;
+    float tx, ty, tz;
+    locate(uvw.x, scale.x, n.x, i, tx);
+    locate(uvw.y, scale.y, n.y, j, ty);
+    locate(uvw.z, scale.z, n.z, k, tz);
+    const float* p = v + size_t(i) + sy * size_t(j) + sz * size_t(k);
+    const float c00 = p[0] + (p[1] - p[0]) * tx;
+    const float c10 = p[sy] + (p[sy + 1] - p[sy]) * tx;
+    const float c01 = p[sz] + (p[sz + 1] - p[sz]) * tx;
+    const float c11 = p[sz + sy] + (p[sz + sy + 1] - p[sz + sy]) * tx;
+    const float c0 = c00 + (c10 - c00) * ty;
+    const float c1 = c01 + (c11 - c01) * ty;
+    return c0 + (c1 - c0) * tz;
+  }
+};
+
+// Bound on the slope of the trilinear interpolant of distance values (each axis difference of
+// a distance is at most the spacing): lets a sphere skip its sample while the last one, minus
+// the most the field can have dropped since, still keeps it clear.
+constexpr float kInterpolantLipschitz = 1.7321f;
+
+}  // namespace
+
+// One finger's advance with joints firstFree.. moving: what evaluate() needs, and each moving
+// sphere's last sample (curl and clearance) for skipping samples that cannot matter.
+struct OursSolver::Stage {
+  int finger = 0;
+  int firstFree = 0;
+  const glm::mat3* toBox = nullptr;
+  glm::vec3 toBoxOffset{0.0f};
+  const FastSampler* sample = nullptr;
+  bool lazy = false;  // false until every sphere has a sample
+  std::array<float, kMaxSpheres> lastA{};
+  std::array<float, kMaxSpheres> lastG{};
+};
+
 Status OursSolver::prepare(const HandModel& hand, const GridBox& box,
                            const SolverOptions& options) {
   prepared_ = false;
@@ -229,10 +288,8 @@ Status OursSolver::prepare(const HandModel& hand, const GridBox& box,
   return Status::ok;
 }
 
-void OursSolver::evaluate(int finger, const glm::mat3& toBox, const glm::vec3& toBoxOffset,
-                          const SdfGrid& field, const JointCurls& curls, int firstFree,
-                          Eval& e) const {
-  const FingerRig& fr = fingers_[finger];
+void OursSolver::evaluate(Stage& st, const JointCurls& curls, float a, Eval& e) const {
+  const FingerRig& fr = fingers_[st.finger];
   const int n = fr.joints;
   std::array<glm::vec3, kMaxJoints + 1> hand{};
   if (fr.ownKinematics) {
@@ -248,27 +305,51 @@ void OursSolver::evaluate(int finger, const glm::mat3& toBox, const glm::vec3& t
     hand[n] = q * fr.tipOffset + p;
   } else {
     std::array<Pose, kMaxJoints + 1> poses{};
-    hand_.fingerPose(Finger(finger), curls, std::span(poses.data(), n + 1));
+    hand_.fingerPose(Finger(st.finger), curls, std::span(poses.data(), n + 1));
     for (int j = 0; j <= n; ++j) hand[j] = poses[j].position;
   }
   std::array<glm::vec3, kMaxJoints + 1> uvw{};
-  for (int j = 0; j <= n; ++j) uvw[j] = toBox * hand[j] + toBoxOffset;
+  for (int j = 0; j <= n; ++j) uvw[j] = *st.toBox * hand[j] + st.toBoxOffset;
 
+  const std::array<float, kMaxSpheres>& speed = fr.speed[st.firstFree];
+  // Lower bounds on each sphere's clearance from its last sample. Spheres whose bound allows a
+  // step well beyond the smallest one, and that are not near the surface, keep their bound.
+  std::array<float, kMaxSpheres> bound{};
+  float minStepBound = std::numeric_limits<float>::max();
+  if (st.lazy) {
+    for (int i = 0; i < fr.sphereCount; ++i) {
+      if (fr.spheres[i].bone < st.firstFree) continue;
+      bound[i] = st.lastG[i] - kInterpolantLipschitz * speed[i] * std::abs(a - st.lastA[i]);
+      if (speed[i] > 0.0f)
+        minStepBound = std::min(minStepBound, std::max(bound[i], 0.0f) / speed[i]);
+    }
+  }
   e = Eval{};
-  const std::array<float, kMaxSpheres>& speed = fr.speed[firstFree];
   for (int i = 0; i < fr.sphereCount; ++i) {
     const Sphere& s = fr.spheres[i];
-    if (s.bone < firstFree) continue;  // stopped: it cannot move any more
-    const glm::vec3 c = uvw[s.bone] + s.t * (uvw[s.bone + 1] - uvw[s.bone]);
-    const float value = field.sampleNormalized(c);
-    const float g = value - s.testRadius;
+    if (s.bone < st.firstFree) continue;  // stopped: it cannot move any more
+    float g;
+    float value = 0.0f;
+    bool sampled = true;
+    if (st.lazy && bound[i] > kSecantBand && speed[i] > 0.0f &&
+        bound[i] / speed[i] > 2.0f * minStepBound) {
+      g = bound[i];
+      sampled = false;
+    } else {
+      const glm::vec3 c = uvw[s.bone] + s.t * (uvw[s.bone + 1] - uvw[s.bone]);
+      value = (*st.sample)(c);
+      g = value - s.testRadius;
+      st.lastA[i] = a;
+      st.lastG[i] = g;
+    }
     if (g < e.g) {
       e.g = g;
       e.arg = i;
-      e.value = value;
+      e.value = sampled ? value : g + s.testRadius;
     }
     if (speed[i] > 0.0f) e.step = std::min(e.step, std::max(g, 0.0f) / speed[i]);
   }
+  st.lazy = true;
   if (e.arg >= 0) {
     const Sphere& s = fr.spheres[e.arg];
     e.point = hand[s.bone] + s.t * (hand[s.bone + 1] - hand[s.bone]);
@@ -283,15 +364,15 @@ void OursSolver::evaluate(int finger, const glm::mat3& toBox, const glm::vec3& t
 // are distances is sqrt(3)-Lipschitz, so over that motion it cannot fall from g to below zero
 // and rise back above zero (that needs a slope of 2). Every crossing of the stop distance is thus
 // seen by some sample, and then bracketed and refined.
-float OursSolver::stage(int finger, const glm::mat3& toBox, const glm::vec3& toBoxOffset,
-                        const SdfGrid& field, JointCurls& curls, int firstFree, float a,
-                        int& touching, glm::vec3& touchPoint, float& touchValue) const {
-  const FingerRig& fr = fingers_[finger];
+float OursSolver::stage(Stage& st, JointCurls& curls, float a, int& touching, glm::vec3& touchPoint,
+                        float& touchValue) const {
+  const FingerRig& fr = fingers_[st.finger];
+  const int firstFree = st.firstFree;
   const int n = fr.joints;
   const float tol = kContactTolerance;
   auto at = [&](float v, Eval& e) {
     for (int j = firstFree; j < n; ++j) curls[j] = v;
-    evaluate(finger, toBox, toBoxOffset, field, curls, firstFree, e);
+    evaluate(st, curls, v, e);
   };
   auto finish = [&](float v, const Eval& e) {
     for (int j = firstFree; j < n; ++j) curls[j] = v;
@@ -397,6 +478,7 @@ Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {
   glm::mat3 toBox;
   glm::vec3 toBoxOffset;
   normalizedMap(field.box(), out.handCorrection, toBox, toBoxOffset);
+  const FastSampler sampler(field);
 
   for (int f = 0; f < kFingerCount; ++f) {
     const FingerRig& fr = fingers_[f];
@@ -409,7 +491,13 @@ Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {
       int touching = -1;
       glm::vec3 point(0.0f);
       float value = 0.0f;
-      a = stage(f, toBox, toBoxOffset, field, curls, firstFree, a, touching, point, value);
+      Stage st;
+      st.finger = f;
+      st.firstFree = firstFree;
+      st.toBox = &toBox;
+      st.toBoxOffset = toBoxOffset;
+      st.sample = &sampler;
+      a = stage(st, curls, a, touching, point, value);
       if (touching < 0) break;
       // The most distal contact is the one reported: it is where the finger ends up resting.
       state.contact = true;

@@ -107,12 +107,11 @@ class OursSolver final : public GraspSolver {
     bool ownKinematics = true;  // false: the model's curve is not a per-joint slerp; ask it
   };
   struct Eval;
+  struct Stage;
 
-  float stage(int finger, const glm::mat3& toBox, const glm::vec3& toBoxOffset,
-              const SdfGrid& field, JointCurls& curls, int firstFree, float a, int& touching,
-              glm::vec3& touchPoint, float& touchValue) const;
-  void evaluate(int finger, const glm::mat3& toBox, const glm::vec3& toBoxOffset,
-                const SdfGrid& field, const JointCurls& curls, int firstFree, Eval& e) const;
+  float stage(Stage& st, JointCurls& curls, float a, int& touching, glm::vec3& touchPoint,
+              float& touchValue) const;
+  void evaluate(Stage& st, const JointCurls& curls, float a, Eval& e) const;
 
   HandModel hand_{};
   GridBox box_{};

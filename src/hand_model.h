@@ -110,10 +110,12 @@ class HandModel {
   glm::vec3 tipPosition(Finger finger, float a) const;
 
   // The tip's curve sampled at a_k = min(k * da, 1), k = 0, 1, ... up to and including a = 1.
-  // Any da in (0, 1]; returns an empty vector otherwise.
+  // Any da in (0, 1]; returns an empty vector otherwise, and for da < kMinCurveStep (more than
+  // 100001 samples), so a stray tiny step cannot exhaust memory.
   std::vector<glm::vec3> tipCurve(Finger finger, float da) const;
   // Curl values of tipCurve() samples: a_k = min(k * da, 1).
   static std::vector<float> curveParameters(float da);
+  static constexpr float kMinCurveStep = 1e-5f;
 
   // Spheres covering every phalanx of the finger at curl `a` (from the proximal phalanx to the
   // tip), spaced so neighbours overlap by at least half the smaller radius. Appends to `out`.
@@ -126,14 +128,25 @@ class HandModel {
 
  private:
   struct JointRig {
-    glm::vec3 offset{0.0f};              // position in the parent joint's frame
-    glm::quat openRotation{1, 0, 0, 0};  // local rotation relative to the parent, a = 0
+    glm::vec3 offset{0.0f};                // position in the parent joint's frame
+    glm::quat openRotation{1, 0, 0, 0};    // local rotation relative to the parent, a = 0
     glm::quat closedRotation{1, 0, 0, 0};  // local rotation relative to the parent, a = 1
     float radius = 0.0f;
   };
 
+  // Precomputed form of the slerp from openRotation to closedRotation (shortest path):
+  // local(a) = openRotation * angleAxis(a * angle, axis). Keeps acos out of the solver loops.
+  struct CurlStep {
+    glm::vec3 axis{1.0f, 0.0f, 0.0f};
+    float angle = 0.0f;
+  };
+
+  void updateCurlSteps();
+  glm::quat localRotation(int joint, float a) const;
+
   Hand side_ = Hand::right;
   std::array<JointRig, kJointCount> rig_{};
+  std::array<CurlStep, kJointCount> curl_{};
 };
 
 }  // namespace sdfg

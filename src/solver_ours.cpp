@@ -23,6 +23,11 @@ constexpr float kMinMotion = 0.0005f;  // metres
 // contact, limited to maxJump (one sphere radius of motion, so nothing is stepped over).
 constexpr float kSecantBand = 0.004f;  // metres
 constexpr int kMaxAdvanceIterations = 200;
+// The final polish on the curvature-corrected field (see polish()).
+constexpr float kMaxPolishClose = 0.004f;          // metres of (bounded) sphere motion, closing
+constexpr float kMaxPolishOpen = 0.012f;           // and opening, which is always safe
+constexpr float kMaxTrilinearOvershoot = 0.0015f;  // metres
+constexpr int kMaxPolishIterations = 8;
 constexpr int kMaxRefineIterations = 40;
 // Kinematics rebuilt from fingerPose() must match it this closely, else solve() asks the model.
 constexpr float kKinematicsTolerance = 2e-5f;  // metres
@@ -54,7 +59,8 @@ struct OursSolver::Eval {
   int arg = -1;
   float step = std::numeric_limits<float>::max();
   float value = 0.0f;
-  glm::vec3 point{0.0f};  // hand space (corrected frame)
+  glm::vec3 point{0.0f};                           // hand space (corrected frame)
+  float gTri = std::numeric_limits<float>::max();  // smallest clearance on the plain trilinear
 };
 
 namespace {
@@ -94,6 +100,40 @@ struct FastSampler {
     const float c1 = c01 + (c11 - c01) * ty;
     return c0 + (c1 - c0) * tz;
   }
+
+  // Second difference of the node values along `axis` at node p (0 at the grid's faces).
+  float secondDifference(const glm::ivec3& p, int axis) const {
+    if (p[axis] <= 0 || p[axis] >= n[axis] - 1) return 0.0f;
+    const size_t stride = axis == 0 ? 1 : (axis == 1 ? sy : sz);
+    const float* c = v + size_t(p.x) + sy * size_t(p.y) + sz * size_t(p.z);
+    return c[stride] - 2.0f * c[0] + c[-std::ptrdiff_t(stride)];
+  }
+
+  // Trilinear value minus its leading error term. Linear interpolation of f between nodes h
+  // apart misses t(1-t)/2 h^2 f'' at fraction t; f'' comes from the nodes' second differences,
+  // blended trilinearly, so the result stays continuous. On smooth parts of a distance field
+  // this cuts the 16^3 error about tenfold (median 0.8 -> 0.07 mm on spheres and boxes).
+  float corrected(const glm::vec3& uvw, float trilinear) const {
+    int idx[3];
+    float t[3];
+    locate(uvw.x, scale.x, n.x, idx[0], t[0]);
+    locate(uvw.y, scale.y, n.y, idx[1], t[1]);
+    locate(uvw.z, scale.z, n.z, idx[2], t[2]);
+    float correction = 0.0f;
+    for (int axis = 0; axis < 3; ++axis) {
+      const float bend = t[axis] * (1.0f - t[axis]) * 0.5f;
+      if (bend <= 0.0f) continue;
+      float d = 0.0f;
+      for (int c = 0; c < 8; ++c) {
+        const glm::ivec3 o(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+        const float w =
+            (o.x ? t[0] : 1.0f - t[0]) * (o.y ? t[1] : 1.0f - t[1]) * (o.z ? t[2] : 1.0f - t[2]);
+        d += w * secondDifference(glm::ivec3(idx[0], idx[1], idx[2]) + o, axis);
+      }
+      correction += bend * d;
+    }
+    return trilinear - correction;
+  }
 };
 
 // Bound on the slope of the trilinear interpolant of distance values (each axis difference of
@@ -111,7 +151,8 @@ struct OursSolver::Stage {
   const glm::mat3* toBox = nullptr;
   glm::vec3 toBoxOffset{0.0f};
   const FastSampler* sample = nullptr;
-  bool lazy = false;  // false until every sphere has a sample
+  bool lazy = false;    // false until every sphere has a sample
+  float aStart = 0.0f;  // where the stage began: polish() never opens the joints past it
   std::array<float, kMaxSpheres> lastA{};
   std::array<float, kMaxSpheres> lastG{};
 };
@@ -288,7 +329,8 @@ Status OursSolver::prepare(const HandModel& hand, const GridBox& box,
   return Status::ok;
 }
 
-void OursSolver::evaluate(Stage& st, const JointCurls& curls, float a, Eval& e) const {
+void OursSolver::evaluate(Stage& st, const JointCurls& curls, float a, Eval& e,
+                          bool corrected) const {
   const FingerRig& fr = fingers_[st.finger];
   const int n = fr.joints;
   std::array<glm::vec3, kMaxJoints + 1> hand{};
@@ -335,12 +377,18 @@ void OursSolver::evaluate(Stage& st, const JointCurls& curls, float a, Eval& e) 
         bound[i] / speed[i] > 2.0f * minStepBound) {
       g = bound[i];
       sampled = false;
+      e.gTri = std::min(e.gTri, g);
     } else {
       const glm::vec3 c = uvw[s.bone] + s.t * (uvw[s.bone + 1] - uvw[s.bone]);
       value = (*st.sample)(c);
       g = value - s.testRadius;
       st.lastA[i] = a;
       st.lastG[i] = g;
+      e.gTri = std::min(e.gTri, g);
+      if (corrected && g < kSecantBand) {
+        value = st.sample->corrected(c, value);
+        g = value - s.testRadius;
+      }
     }
     if (g < e.g) {
       e.g = g;
@@ -372,9 +420,12 @@ float OursSolver::stage(Stage& st, JointCurls& curls, float a, int& touching, gl
   const float tol = kContactTolerance;
   auto at = [&](float v, Eval& e) {
     for (int j = firstFree; j < n; ++j) curls[j] = v;
-    evaluate(st, curls, v, e);
+    evaluate(st, curls, v, e, false);
   };
-  auto finish = [&](float v, const Eval& e) {
+  const float aStart = a;
+  auto finish = [&](float v, Eval e) {
+    st.aStart = aStart;
+    v = polish(st, curls, v, e);
     for (int j = firstFree; j < n; ++j) curls[j] = v;
     touching = e.arg;
     touchPoint = e.point;
@@ -460,6 +511,68 @@ float OursSolver::stage(Stage& st, JointCurls& curls, float a, int& touching, gl
     return finish(aLo, e);
   }
   return finish(aLo, lo);
+}
+
+// Moves a contact found on the trilinear field to the root of the curvature-corrected field
+// (FastSampler::corrected) by a few secant steps from the trilinear answer. Only spheres near
+// the surface are corrected, a closing move is bounded (kMaxPolishClose of sphere motion, so it
+// cannot step over anything) and a forward move may not take the trilinear clearance below
+// -kMaxTrilinearOvershoot (guards against creases where the correction is unreliable). The
+// result is a pose whose corrected clearance is in [0, tol] when one was found, else the safest
+// pose tried.
+float OursSolver::polish(Stage& st, JointCurls& curls, float a, Eval& e) const {
+  const FingerRig& fr = fingers_[st.finger];
+  const int n = fr.joints;
+  const float tol = kContactTolerance;
+  auto at = [&](float v, Eval& out) {
+    for (int j = st.firstFree; j < n; ++j) curls[j] = v;
+    evaluate(st, curls, v, out, true);
+  };
+  Eval e0;
+  at(a, e0);
+  if (e0.arg < 0) return a;
+  if (e0.g >= 0.0f && e0.g <= tol) {
+    e = e0;
+    return a;
+  }
+  const float speed = std::max(fr.speed[st.firstFree][e0.arg], 1e-6f);
+  const float lowest = std::max(st.aStart, a - kMaxPolishOpen / speed);
+  const float highest = std::min(1.0f, a + kMaxPolishClose / speed);
+  // Second point for the secant: a small step toward where the root should be.
+  float a1 = std::clamp(a + (e0.g > 0.0f ? 1.0f : -1.0f) * 0.0005f / speed, lowest, highest);
+  if (a1 == a) return a;
+  float aPrev = a, gPrev = e0.g;
+  float bestA = a;
+  Eval best = e0;
+  bool bestSafe = e0.g >= 0.0f;
+  for (int it = 0; it < kMaxPolishIterations; ++it) {
+    Eval e1;
+    at(a1, e1);
+    const bool guard = a1 <= a || e1.gTri >= -kMaxTrilinearOvershoot;
+    const bool safe = e1.g >= 0.0f && guard;
+    if (safe && (!bestSafe || a1 > bestA)) {
+      bestA = a1;
+      best = e1;
+      bestSafe = true;
+    } else if (!bestSafe && !safe && a1 < bestA) {
+      bestA = a1;  // nothing safe yet: keep the most open pose
+      best = e1;
+    }
+    if (safe && e1.g <= tol) break;
+    if (!guard) break;
+    const float slope = (e1.g - gPrev) / (a1 - aPrev);
+    if (!(slope < 0.0f)) break;  // the corrected field does not fall as the finger closes here
+    const float next = std::clamp(a1 + (0.5f * tol - e1.g) / slope, lowest, highest);
+    aPrev = a1;
+    gPrev = e1.g;
+    if (std::abs(next - a1) < 1e-7f) break;
+    a1 = next;
+  }
+  // Nothing safe found (the corrected field says the trilinear contact is inside and the
+  // opening range ran out): the most open pose tried is the best there is.
+  for (int j = st.firstFree; j < n; ++j) curls[j] = bestA;
+  e = best;
+  return bestA;
 }
 
 Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {

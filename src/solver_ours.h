@@ -111,7 +111,8 @@ class OursSolver final : public GraspSolver {
 
   float stage(Stage& st, JointCurls& curls, float a, int& touching, glm::vec3& touchPoint,
               float& touchValue) const;
-  void evaluate(Stage& st, const JointCurls& curls, float a, Eval& e) const;
+  void evaluate(Stage& st, const JointCurls& curls, float a, Eval& e, bool corrected) const;
+  float polish(Stage& st, JointCurls& curls, float a, Eval& e) const;
 
   HandModel hand_{};
   GridBox box_{};

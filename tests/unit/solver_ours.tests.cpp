@@ -137,19 +137,28 @@ TEST_CASE("ours: fingers stop on the surface of analytic shapes, never inside", 
         const SdfGrid grid = analyticGrid(shape.fn, resolution);
         const Solved s = solveOurs(grid);
         REQUIRE(s.status == Status::ok);
+        // The field's own error at the nodes' spacing bounds how far from the true surface a
+        // stop can be: the corrected reconstruction keeps it well under a millimetre here.
+        const float allowed = resolution == 16 ? 0.001f : 0.0003f;
         int contacts = 0;
         for (int f = 0; f < kFingerCount; ++f) {
           const FingerState& st = s.result.fingers[f];
           CAPTURE(fingerName(Finger(f)), st.curl, st.contact);
-          // No capsule point ends inside the sampled field.
-          CHECK(capsuleClearance(grid, hand, Finger(f), st.jointCurls) >= -kFieldTolerance - 1e-3f);
+          // No capsule point ends inside the object (exact distance), beyond the field's error.
+          float exactClearance = 1e9f;
+          for (const CapsulePoint& c : capsule(hand, Finger(f), st.jointCurls))
+            exactClearance = std::min(exactClearance, shape.fn(c.centre) - c.radius);
+          CHECK(exactClearance >= -allowed);
+          // Nor inside the sampled field beyond what the final polish may allow.
+          CHECK(capsuleClearance(grid, hand, Finger(f), st.jointCurls) >= -0.002f);
           if (st.contact) {
             ++contacts;
-            // The reported contact is at the threshold on the field (the stopping sphere's own
-            // radius plus its small cover margin).
-            CHECK(st.distance >= 0.0f);
-            const float value = grid.sample(st.contactPoint);
-            CHECK(value == Approx(st.distance).margin(1e-5f));
+            // The reported distance is the field's at the contact sphere: near the true one
+            // there (box edges are the field's worst case: its correction assumes smoothness).
+            CHECK(st.distance > 0.0f);
+            CHECK(shape.fn(st.contactPoint) == Approx(st.distance).margin(1.5f * allowed));
+            // And the finger touches: its closest capsule point is near the surface.
+            CHECK(exactClearance <= allowed + 0.001f);
           }
           for (float c : st.jointCurls) {
             CHECK(c >= 0.0f);

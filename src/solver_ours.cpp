@@ -23,6 +23,9 @@ constexpr float kMinMotion = 0.0005f;  // metres
 // contact, limited to maxJump (one sphere radius of motion, so nothing is stepped over).
 constexpr float kSecantBand = 0.004f;  // metres
 constexpr int kMaxAdvanceIterations = 200;
+// Spheres whose trilinear clearance is below this are also read on the curvature-corrected
+// reconstruction, which can sit this much below the trilinear value near thin parts.
+constexpr float kCorrectBand = 0.008f;  // metres
 // The final polish on the curvature-corrected field (see polish()).
 constexpr float kMaxPolishClose = 0.004f;          // metres of (bounded) sphere motion, closing
 constexpr float kMaxPolishOpen = 0.012f;           // and opening, which is always safe
@@ -373,9 +376,9 @@ void OursSolver::evaluate(Stage& st, const JointCurls& curls, float a, Eval& e,
     float g;
     float value = 0.0f;
     bool sampled = true;
-    if (st.lazy && bound[i] > kSecantBand && speed[i] > 0.0f &&
+    if (st.lazy && bound[i] > kCorrectBand && speed[i] > 0.0f &&
         bound[i] / speed[i] > 2.0f * minStepBound) {
-      g = bound[i];
+      g = std::min(bound[i], kCorrectBand);
       sampled = false;
       e.gTri = std::min(e.gTri, g);
     } else {
@@ -385,9 +388,14 @@ void OursSolver::evaluate(Stage& st, const JointCurls& curls, float a, Eval& e,
       st.lastA[i] = a;
       st.lastG[i] = g;
       e.gTri = std::min(e.gTri, g);
-      if (corrected && g < kSecantBand) {
-        value = st.sample->corrected(c, value);
-        g = value - s.testRadius;
+      if (g < kCorrectBand) {
+        // Advancing: stop on whichever of the two says nearer (a thin part or a sharp convex
+        // edge reads too far on the trilinear field). Polishing: the corrected one alone.
+        const float fixedValue = st.sample->corrected(c, value);
+        if (corrected || fixedValue < value) {
+          value = fixedValue;
+          g = value - s.testRadius;
+        }
       }
     }
     if (g < e.g) {

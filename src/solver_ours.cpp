@@ -164,13 +164,9 @@ Status OursSolver::prepare(const HandModel& hand, const GridBox& box,
                            const SolverOptions& options) {
   prepared_ = false;
   error_.clear();
-  if (!(std::isfinite(options.da) && options.da > 0.0f && options.da <= 1.0f)) {
-    error_ = "ours: da = " + std::to_string(options.da) + " must be finite and in (0, 1]";
-    return Status::invalid_argument;
-  }
-  if (!std::isfinite(options.threshold)) {
-    error_ = "ours: threshold must be finite (negative: each sphere's own radius)";
-    return Status::invalid_argument;
+  if (std::optional<Error> e = validateSolverOptions(options)) {
+    error_ = "ours: " + e->message;
+    return e->code;
   }
   if (std::optional<Error> e = box.validate()) {
     error_ = "ours: " + e->message;

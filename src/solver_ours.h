@@ -79,6 +79,7 @@ class OursSolver final : public GraspSolver {
   Status solve(const GraspScene& scene, GraspResult& out) const override;
 
   // Why the last prepare() failed; empty after a successful one.
+  std::string_view prepareError() const override { return error_; }
   std::string_view lastError() const { return error_; }
 
  private:

@@ -209,6 +209,22 @@ TEST_CASE("ours: a thin plate that fixed curl steps skip stops the finger at any
     }
     CHECK(skipped >= 2);
   }
+  SECTION("so does the \"paper\" strategy at da = 0.1") {
+    auto paper = createSolver("paper");
+    REQUIRE(paper.ok());
+    SolverOptions options;
+    options.da = 0.1f;
+    REQUIRE((*paper)->prepare(hand, grid.box(), options) == Status::ok);
+    GraspScene scene;
+    scene.field = &grid;
+    GraspResult out;
+    REQUIRE((*paper)->solve(scene, out) == Status::ok);
+    int skipped = 0;
+    for (Finger f : {Finger::index, Finger::middle, Finger::ring}) {
+      if (sweptThrough(plate, hand, f, out.fingers[int(f)].curl)) ++skipped;
+    }
+    CHECK(skipped >= 2);
+  }
   SECTION("ours stops every finger that meets it, whatever da") {
     for (float da : {0.5f, 0.1f, 0.01f}) {
       SolverOptions options;

@@ -1,0 +1,82 @@
+// Test interface of the SDFG mock OpenXR runtime (tests/mock_runtime).
+//
+// The mock runtime is a headless OpenXR 1.0 runtime loaded by the real Khronos loader through
+// XR_RUNTIME_JSON. Tests steer it in two ways, both described in docs/mock-runtime.md:
+//   - environment variables, read when the instance is created (names below);
+//   - test-only functions, which are no OpenXR extension: fetch them with
+//     xrGetInstanceProcAddr(instance, "xrMockRuntime...SDFG", ...) like any other command.
+// Include <openxr/openxr.h> before this header.
+#pragma once
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+// Timeline file (text, one keyframe per line; format in docs/mock-runtime.md).
+#define SDFG_MOCK_ENV_SCRIPT "SDFG_MOCK_SCRIPT"
+// After this many xrEndFrame calls the runtime ends the session (VISIBLE, SYNCHRONIZED,
+// STOPPING, then IDLE and EXITING after xrEndSession). Unset or 0: never.
+#define SDFG_MOCK_ENV_END_AFTER_FRAMES "SDFG_MOCK_END_AFTER_FRAMES"
+// "1" (default): XR_EXT_hand_tracking offered and supported; "0": offered, but the system
+// reports supportsHandTracking = XR_FALSE (xrCreateHandTrackerEXT -> FEATURE_UNSUPPORTED);
+// "absent": not offered at all (a runtime with controllers only).
+#define SDFG_MOCK_ENV_HAND_TRACKING "SDFG_MOCK_HAND_TRACKING"
+// Path of a binary PPM (P6) that receives the last image submitted for the left view, written
+// when the session is destroyed. Setting it (or SDFG_MOCK_REPORT) turns on frame capture.
+#define SDFG_MOCK_ENV_CAPTURE "SDFG_MOCK_CAPTURE"
+// Path of a "key value" text report (frame counts, capture summary) written when the session
+// is destroyed; the hello_xr client test reads it.
+#define SDFG_MOCK_ENV_REPORT "SDFG_MOCK_REPORT"
+// Interaction profile of the simulated controllers (default /interaction_profiles/oculus/
+// touch_controller). The script directive "profile" overrides it.
+#define SDFG_MOCK_ENV_PROFILE "SDFG_MOCK_PROFILE"
+// One deliberate misbehaviour, so tests can prove their checks catch it:
+// "skip_layout_transition": swapchain images stay in VK_IMAGE_LAYOUT_UNDEFINED (the Vulkan
+// validation layer then reports the app's render pass).
+#define SDFG_MOCK_ENV_FAULT "SDFG_MOCK_FAULT"
+// "1": log every error the runtime returns, and why, on stderr.
+#define SDFG_MOCK_ENV_LOG "SDFG_MOCK_LOG"
+
+// Counters and last values of one session, for tests to assert on.
+typedef struct XrMockRuntimeStatsSDFG {
+  XrSessionState state;       // last state queued for the application
+  uint64_t frameIndex;        // frame the script is sampled at (= framesEnded)
+  uint64_t framesWaited;      // xrWaitFrame calls that succeeded
+  uint64_t framesBegun;       // xrBeginFrame calls that succeeded
+  uint64_t framesEnded;       // xrEndFrame calls that succeeded
+  uint64_t framesWithLayers;  // ... of which submitted at least one composition layer
+  uint64_t framesCaptured;    // frames whose projection images were copied to memory
+  uint32_t lastLayerCount;    // layerCount of the last successful xrEndFrame
+  XrPath currentProfile;      // interaction profile in use, XR_NULL_PATH before attach
+  uint64_t hapticCount[2];    // xrApplyHapticFeedback calls per hand (0 left, 1 right)
+  float lastHapticAmplitude[2];
+  uint64_t syncCount;                             // xrSyncActions calls that succeeded
+  XrHandJointsMotionRangeEXT lastMotionRange[2];  // last requested per hand, 0 if none
+} XrMockRuntimeStatsSDFG;
+
+// Replaces the instance's timeline (and its directives) with `scriptText`, a NUL-terminated
+// string in the timeline file format. Errors: XR_ERROR_VALIDATION_FAILURE when the text does
+// not parse (the old timeline stays), XR_ERROR_HANDLE_INVALID for a bad instance.
+typedef XrResult(XRAPI_PTR* PFN_xrMockRuntimeSetScriptSDFG)(XrInstance instance,
+                                                            const char* scriptText);
+
+// Fills `stats` (caller-owned) for `session`.
+typedef XrResult(XRAPI_PTR* PFN_xrMockRuntimeGetStatsSDFG)(XrSession session,
+                                                           XrMockRuntimeStatsSDFG* stats);
+
+// Copies the last captured image of projection view `viewIndex` (0 left, 1 right) as tightly
+// packed RGBA8 rows, top row first, into `rgba` (caller-owned, `capacityBytes` bytes). Two-call
+// idiom: with capacityBytes 0 only width and height are written. Capture must be on (script
+// directive "capture 1", or the environment variables above).
+// Errors: XR_ERROR_SIZE_INSUFFICIENT when capacityBytes < width * height * 4 (and not 0);
+// XR_ERROR_VALIDATION_FAILURE when nothing was captured for that view.
+typedef XrResult(XRAPI_PTR* PFN_xrMockRuntimeGetCaptureSDFG)(XrSession session, uint32_t viewIndex,
+                                                             uint32_t capacityBytes,
+                                                             uint32_t* width, uint32_t* height,
+                                                             uint8_t* rgba);
+
+#ifdef __cplusplus
+}
+#endif

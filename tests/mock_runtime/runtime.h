@@ -1,0 +1,306 @@
+// Internal state of the mock runtime: handle objects, the global handle table, error helpers
+// and the entry points each concept file implements. Not for tests (they use
+// mock_runtime_test.h through the loader).
+//
+// Threading: every entry point runs under one global mutex (see Entry in dispatch.cpp), so the
+// objects below need no locks of their own.
+#pragma once
+
+// openxr_platform.h needs the Vulkan and timespec types declared first.
+#include <time.h>
+#include <vulkan/vulkan.h>
+
+#define XR_USE_GRAPHICS_API_VULKAN
+#define XR_USE_TIMESPEC
+#include <openxr/openxr.h>
+#include <openxr/openxr_platform.h>
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "mock_runtime_test.h"
+#include "script.h"
+
+namespace sdfg::mock {
+
+// ---- errors and logging ------------------------------------------------------------------
+
+// Logs "cmd: message" on stderr when SDFG_MOCK_LOG=1 and returns `result`, so every error path
+// is one return line that also says why.
+XrResult fail(const char* cmd, XrResult result, const char* fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+#define MOCK_VERIFY_NOT_NULL(cmd, arg) \
+  if ((arg) == nullptr) return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "(" #arg ") is null")
+
+#define MOCK_VERIFY_TYPE(cmd, arg, expected)                                                   \
+  MOCK_VERIFY_NOT_NULL(cmd, arg);                                                              \
+  if ((arg)->type != (expected))                                                               \
+  return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "(" #arg "->type) is %d, expected " #expected, \
+              int((arg)->type))
+
+// ---- handles -------------------------------------------------------------------------------
+
+enum class Kind : uint32_t {
+  instance = 1,
+  session,
+  space,
+  actionSet,
+  action,
+  swapchain,
+  handTracker
+};
+
+// Base of every object behind a handle; the handle value is the object's address, and it is
+// valid only while registered in the handle table.
+struct Object {
+  explicit Object(Kind k) : kind(k) {}
+  virtual ~Object() = default;
+  Kind kind;
+};
+
+void registerHandle(Object* object);
+void unregisterHandle(const Object* object);
+Object* findHandle(uint64_t handle);
+
+template <class T, class H>
+T* lookup(H handle) {
+  Object* o = findHandle(reinterpret_cast<uint64_t>(handle));
+  return o != nullptr && o->kind == T::kKind ? static_cast<T*>(o) : nullptr;
+}
+
+template <class H>
+H toHandle(const Object* o) {
+  return reinterpret_cast<H>(const_cast<Object*>(o));
+}
+
+// ---- objects -------------------------------------------------------------------------------
+
+struct Session;
+struct ActionSet;
+struct Instance;
+
+enum class HandTrackingMode { supported, unsupported, absent };
+
+struct Action final : Object {
+  static constexpr Kind kKind = Kind::action;
+  Action() : Object(kKind) {}
+  ActionSet* set = nullptr;
+  std::string name, localizedName;
+  XrActionType type = XR_ACTION_TYPE_BOOLEAN_INPUT;
+  std::vector<XrPath> subactionPaths;
+  bool alive = true;  // destroyed actions stay allocated: action spaces may still use them
+};
+
+struct ActionSet final : Object {
+  static constexpr Kind kKind = Kind::actionSet;
+  ActionSet() : Object(kKind) {}
+  Instance* instance = nullptr;
+  std::string name, localizedName;
+  uint32_t priority = 0;
+  std::vector<Action*> actions;
+  bool attached = false;  // to some session: no more actions or suggestions
+  bool alive = true;
+};
+
+// One suggested binding, resolved against the profile's input list.
+struct Binding {
+  Action* action = nullptr;
+  XrPath path = XR_NULL_PATH;
+  Target hand = kLeft;
+  std::string identifier;  // "squeeze", "grip", "thumbstick", "haptic"
+  std::string component;   // "value", "click", "pose", "x", "" for a parent path
+};
+
+struct Options {
+  uint64_t endAfterFrames = 0;  // 0: never
+  std::string profile;          // simulated controller profile
+  bool capture = false;
+  std::string capturePath, reportPath;
+  std::string fault;  // SDFG_MOCK_FAULT: one deliberate misbehaviour, for negative tests
+};
+
+struct Instance final : Object {
+  static constexpr Kind kKind = Kind::instance;
+  Instance() : Object(kKind) {}
+  ~Instance() override;
+
+  bool extVulkan = false, extVulkan2 = false, extHandTracking = false, extHeadless = false,
+       extMotionRange = false, extTimespec = false;
+  HandTrackingMode handTracking = HandTrackingMode::supported;
+  bool systemFetched = false;
+  bool graphicsRequirementsQueried = false;
+  VkPhysicalDevice lastPhysicalDevice = VK_NULL_HANDLE;  // from xrGetVulkanGraphicsDevice*
+  VkInstance lastVkInstance = VK_NULL_HANDLE;            // ... and the instance it came from
+
+  std::vector<std::string> pathStrings{""};  // index = XrPath; 0 is XR_NULL_PATH
+  std::unordered_map<std::string, XrPath> pathIds;
+
+  std::deque<XrEventDataBuffer> events;
+  std::vector<std::unique_ptr<ActionSet>> actionSets;  // dead ones too, freed with the instance
+  std::vector<std::unique_ptr<Action>> actions;
+  std::map<XrPath, std::vector<Binding>> suggested;  // interaction profile -> bindings
+  std::vector<std::unique_ptr<Session>> sessions;
+
+  Script script;
+  Options options;
+
+  XrPath path(const std::string& s);                 // interns a well-formed path
+  const std::string* pathString(XrPath path) const;  // null when unknown
+};
+
+// Runtime-owned Vulkan objects of one session; see vulkan.cpp. The deleter destroys them.
+struct VulkanContext;
+struct VulkanContextDeleter {
+  void operator()(VulkanContext* context) const;
+};
+using VulkanContextPtr = std::unique_ptr<VulkanContext, VulkanContextDeleter>;
+
+struct ActionValue {
+  bool active = false;
+  bool boolean = false;
+  float value = 0;
+  XrVector2f vector{0, 0};
+  bool changed = false;
+  XrTime lastChange = 0;
+};
+// Per action: state for /user/hand/left, /user/hand/right and for XR_NULL_PATH (both).
+using ActionStates = std::array<ActionValue, 3>;
+
+struct CapturedImage {
+  uint32_t width = 0, height = 0;
+  std::vector<uint8_t> rgba;
+};
+
+struct Space final : Object {
+  static constexpr Kind kKind = Kind::space;
+  Space() : Object(kKind) {}
+  Session* session = nullptr;
+  bool isAction = false;
+  XrReferenceSpaceType referenceType = XR_REFERENCE_SPACE_TYPE_LOCAL;
+  Action* action = nullptr;
+  XrPath subactionPath = XR_NULL_PATH;
+  XrPosef offset{};
+};
+
+struct Swapchain final : Object {
+  static constexpr Kind kKind = Kind::swapchain;
+  Swapchain() : Object(kKind) {}
+  ~Swapchain() override;
+  Session* session = nullptr;
+  XrSwapchainCreateInfo info{};
+  uint32_t imageCount = 0;
+  std::vector<VkImage> images;
+  std::vector<VkDeviceMemory> memory;
+  std::vector<bool> layoutReady;  // initial layout transition done
+  std::deque<uint32_t> acquired;  // acquired, not yet released, oldest first
+  bool waited = false;            // the oldest acquired image has been waited on
+  uint32_t nextIndex = 0;
+  int64_t lastReleased = -1;
+  bool staticImageUsed = false;
+};
+
+struct HandTracker final : Object {
+  static constexpr Kind kKind = Kind::handTracker;
+  HandTracker() : Object(kKind) {}
+  Session* session = nullptr;
+  XrHandEXT hand = XR_HAND_LEFT_EXT;
+};
+
+struct Session final : Object {
+  static constexpr Kind kKind = Kind::session;
+  Session() : Object(kKind) {}
+  ~Session() override;
+  Instance* instance = nullptr;
+
+  XrSessionState state = XR_SESSION_STATE_UNKNOWN;  // last state queued
+  bool running = false;
+  bool stopping = false;  // STOPPING queued, waiting for xrEndSession
+  XrViewConfigurationType viewConfiguration = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+
+  bool frameWaited = false;  // xrWaitFrame done, xrBeginFrame not yet
+  bool frameBegun = false;
+  XrTime lastPredicted = 0;
+  XrMockRuntimeStatsSDFG stats{};
+
+  VulkanContextPtr vulkan;  // null: headless session
+  std::vector<std::unique_ptr<Space>> spaces;
+  std::vector<std::unique_ptr<Swapchain>> swapchains;
+  std::vector<std::unique_ptr<HandTracker>> handTrackers;
+
+  std::vector<ActionSet*> attachedSets;
+  XrPath profile = XR_NULL_PATH;
+  std::map<const Action*, ActionStates> actionStates;
+  std::array<CapturedImage, 2> captures;
+
+  uint64_t frame() const { return stats.framesEnded; }
+  bool focused() const { return state == XR_SESSION_STATE_FOCUSED; }
+};
+
+// ---- shared helpers ------------------------------------------------------------------------
+
+XrTime now();
+void queueEvent(Instance& instance, const XrEventDataBuffer& event);
+void queueState(Session& session, XrSessionState state);
+void beginStopping(Session& session);   // queues the states down to STOPPING
+void destroySession(Session* session);  // children first; unregisters everything
+void destroySwapchain(Swapchain* swapchain);
+void writeSessionFiles(Session& session);
+
+// Two-call idiom for arrays: writes count, copies when capacity suffices.
+template <class T>
+XrResult twoCall(const char* cmd, uint32_t capacity, uint32_t* countOutput, T* out, const T* values,
+                 uint32_t count) {
+  MOCK_VERIFY_NOT_NULL(cmd, countOutput);
+  *countOutput = count;
+  if (capacity == 0) return XR_SUCCESS;
+  if (capacity < count)
+    return fail(cmd, XR_ERROR_SIZE_INSUFFICIENT, "capacity %u < %u", capacity, count);
+  MOCK_VERIFY_NOT_NULL(cmd, out);
+  for (uint32_t i = 0; i < count; ++i) out[i] = values[i];
+  return XR_SUCCESS;
+}
+XrResult twoCallString(const char* cmd, uint32_t capacity, uint32_t* countOutput, char* buffer,
+                       const std::string& value);
+
+// Location of a space in LOCAL at the session's current frame; nullopt when untracked.
+std::optional<XrPosef> spacePoseInLocal(const Session& session, const Space& space);
+XrPosef headPose(const Session& session);
+// Controller pose source ("grip" or "aim") of one hand; nullopt when tracking is lost.
+std::optional<XrPosef> controllerPose(const Session& session, Target hand,
+                                      const std::string& which);
+bool handTracked(const Session& session, Target hand);
+
+// Interaction profiles (interaction_profiles.cpp).
+bool isKnownProfile(const std::string& profilePath);
+// Resolves a binding path for a profile; false when the profile has no such input or output.
+bool resolveBinding(const std::string& profilePath, const std::string& bindingPath, Binding& out);
+// Current value of a bound source from the script.
+float readScalar(const Session& session, const Binding& binding, XrActionType type);
+std::string profileLocalizedName(const std::string& profilePath);
+
+// Action state helpers used by spaces.
+bool actionActive(const Session& session, const Action* action, XrPath subactionPath);
+const Binding* poseBinding(const Session& session, const Action* action, XrPath subactionPath);
+int subactionSlot(const Instance& instance, XrPath path);  // 0, 1, 2 (null), -1 other/unknown
+
+// Vulkan (vulkan.cpp).
+XrResult createVulkanContext(const char* cmd, Instance& instance,
+                             const XrGraphicsBindingVulkanKHR& binding, VulkanContextPtr& out);
+void destroyVulkanContext(VulkanContext* context);
+const std::vector<int64_t>& vulkanSwapchainFormats();
+XrResult createVulkanImages(const char* cmd, Swapchain& swapchain);
+void destroyVulkanImages(Swapchain& swapchain);
+XrResult prepareVulkanImage(const char* cmd, Swapchain& swapchain, uint32_t index);
+bool captureVulkanImage(Session& session, Swapchain& swapchain, uint32_t index, uint32_t layer,
+                        CapturedImage& out);
+
+}  // namespace sdfg::mock

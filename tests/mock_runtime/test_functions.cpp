@@ -1,0 +1,41 @@
+// Test-only commands of mock_runtime_test.h that read session state (xrMockRuntimeSetScriptSDFG
+// lives with the instance, which owns the script).
+#include <cstring>
+
+#include "entry_points.h"
+
+namespace sdfg::mock {
+
+XrResult mockGetStats(XrSession handle, XrMockRuntimeStatsSDFG* stats) {
+  constexpr const char* cmd = "xrMockRuntimeGetStatsSDFG";
+  const Session* session = lookup<Session>(handle);
+  if (session == nullptr) return fail(cmd, XR_ERROR_HANDLE_INVALID, "session is not valid");
+  MOCK_VERIFY_NOT_NULL(cmd, stats);
+  *stats = session->stats;
+  return XR_SUCCESS;
+}
+
+XrResult mockGetCapture(XrSession handle, uint32_t viewIndex, uint32_t capacityBytes,
+                        uint32_t* width, uint32_t* height, uint8_t* rgba) {
+  constexpr const char* cmd = "xrMockRuntimeGetCaptureSDFG";
+  const Session* session = lookup<Session>(handle);
+  if (session == nullptr) return fail(cmd, XR_ERROR_HANDLE_INVALID, "session is not valid");
+  MOCK_VERIFY_NOT_NULL(cmd, width);
+  MOCK_VERIFY_NOT_NULL(cmd, height);
+  if (viewIndex >= session->captures.size())
+    return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "viewIndex %u", viewIndex);
+  const CapturedImage& image = session->captures[viewIndex];
+  if (image.rgba.empty())
+    return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "nothing captured for view %u", viewIndex);
+  *width = image.width;
+  *height = image.height;
+  if (capacityBytes == 0) return XR_SUCCESS;
+  if (capacityBytes < image.rgba.size())
+    return fail(cmd, XR_ERROR_SIZE_INSUFFICIENT, "capacityBytes %u < %zu", capacityBytes,
+                image.rgba.size());
+  MOCK_VERIFY_NOT_NULL(cmd, rgba);
+  std::memcpy(rgba, image.rgba.data(), image.rgba.size());
+  return XR_SUCCESS;
+}
+
+}  // namespace sdfg::mock

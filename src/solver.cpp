@@ -1,1 +1,79 @@
-// placeholder: implemented in a later commit
+#include "solver.h"
+
+#include <cmath>
+
+#include "solver_paper.h"
+#include "solver_physics.h"
+
+namespace sdfg {
+
+namespace {
+
+struct SolverEntry {
+  const char* name;
+  std::unique_ptr<GraspSolver> (*make)();
+};
+
+template <class T>
+std::unique_ptr<GraspSolver> makeSolver() {
+  return std::make_unique<T>();
+}
+
+std::unique_ptr<GraspSolver> makePhysicsConvex() {
+  return std::make_unique<PhysicsSolver>(PhysicsCollider::Kind::convexHull);
+}
+std::unique_ptr<GraspSolver> makePhysicsMesh() {
+  return std::make_unique<PhysicsSolver>(PhysicsCollider::Kind::triangleMesh);
+}
+
+// Every strategy, in the order the benchmark lists them. Adding one is one line here.
+constexpr SolverEntry kSolvers[] = {
+    {"paper", &makeSolver<PaperSolver>},
+    {"physics-convex", &makePhysicsConvex},
+    {"physics-mesh", &makePhysicsMesh},
+};
+
+bool inUnitStep(float v) {
+  return std::isfinite(v) && v > 0.0f && v <= 1.0f;
+}
+
+}  // namespace
+
+std::optional<Error> validateSolverOptions(const SolverOptions& options) {
+  if (!inUnitStep(options.da)) {
+    return makeError(
+        Status::invalid_argument,
+        "solver options: da = " + std::to_string(options.da) + " must be finite and in (0, 1]");
+  }
+  if (!inUnitStep(options.refineStep)) {
+    return makeError(Status::invalid_argument,
+                     "solver options: refineStep = " + std::to_string(options.refineStep) +
+                         " must be finite and in (0, 1]");
+  }
+  if (!std::isfinite(options.threshold)) {
+    return makeError(Status::invalid_argument,
+                     "solver options: threshold must be finite (negative: the tip radius)");
+  }
+  return std::nullopt;
+}
+
+std::vector<std::string> solverNames() {
+  std::vector<std::string> names;
+  for (const SolverEntry& entry : kSolvers) names.emplace_back(entry.name);
+  return names;
+}
+
+Result<std::unique_ptr<GraspSolver>> createSolver(std::string_view name) {
+  for (const SolverEntry& entry : kSolvers) {
+    if (name == entry.name) return entry.make();
+  }
+  std::string known;
+  for (const SolverEntry& entry : kSolvers) {
+    if (!known.empty()) known += ", ";
+    known += entry.name;
+  }
+  return makeError(Status::invalid_argument,
+                   "solver: unknown strategy \"" + std::string(name) + "\"; known: " + known);
+}
+
+}  // namespace sdfg

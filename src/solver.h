@@ -9,6 +9,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -66,7 +67,14 @@ class GraspSolver {
   // Solves one grasp into `out`. Fails when not prepared or when the scene lacks what
   // needsField()/needsCollider() ask for. Never allocates for the SDF strategies.
   virtual Status solve(const GraspScene& scene, GraspResult& out) const = 0;
+
+  // Why the last prepare() failed, naming the option or input; empty after a successful one.
+  virtual std::string_view prepareError() const { return {}; }
 };
+
+// Checks the options every strategy shares: da and refineStep finite and in (0, 1], threshold
+// finite (negative means "the finger's tip radius"). Returns the first problem, or nothing.
+std::optional<Error> validateSolverOptions(const SolverOptions& options);
 
 // Names accepted by createSolver(), in the order the benchmark lists them.
 std::vector<std::string> solverNames();

@@ -45,6 +45,12 @@ class MeshDistance {
   // Skips subtrees farther than `maxDistance`; returns infinity when nothing is that close.
   ClosestPoint closestWithin(const glm::vec3& p, float maxDistance) const;
   float signedDistance(const glm::vec3& p) const;
+  // signedDistance(p) seeded with a triangle likely to be near `p` (in a sweep over grid nodes,
+  // the previous node's closest triangle): its exact distance bounds the search, so far less of
+  // the hierarchy is visited. Same value as signedDistance(p) whatever the hint; a hint out of
+  // range is ignored. Writes the closest triangle to *closestTriangle when it is not null.
+  float signedDistanceNear(const glm::vec3& p, uint32_t hintTriangle,
+                           uint32_t* closestTriangle = nullptr) const;
   // Generalized winding number: ~1 inside, ~0 outside, fractional near holes.
   float windingNumber(const glm::vec3& p) const;
 

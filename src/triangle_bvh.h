@@ -1,0 +1,97 @@
+// A bounding volume hierarchy over the triangles of one mesh, for exact closest-point queries.
+//
+// Built once per mesh (binned surface-area heuristic, leaves of a few triangles, one flat node
+// array) and refit in O(n) when the vertices move with the same topology. The closest-point
+// query walks the nearer child first and prunes every subtree farther than the best distance
+// found so far; it can be seeded with a known bound (a triangle near the previous query point),
+// which is what makes sweeps over grid nodes cheap. Point-triangle distances are computed in
+// double precision and report which feature of the triangle (face, edge, vertex) is closest, so
+// callers can pick the matching pseudo-normal for the sign.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace sdfg {
+
+// Which part of a triangle (a, b, c) holds the closest point. Edge i joins vertex i and vertex
+// (i + 1) % 3: edge0 = ab, edge1 = bc, edge2 = ca.
+enum class TriangleFeature : uint8_t { face, edge0, edge1, edge2, vertex0, vertex1, vertex2 };
+
+struct TriangleClosest {
+  glm::dvec3 point{0.0};
+  double distanceSquared = 0.0;
+  TriangleFeature feature = TriangleFeature::face;
+};
+
+// Exact closest point of `p` on triangle (a, b, c) (Ericson, Real-Time Collision Detection,
+// 5.1.5: Voronoi regions of the vertices, then the edges, then the face). The triangle must not
+// be degenerate.
+TriangleClosest closestPointOnTriangle(const glm::dvec3& p, const glm::dvec3& a,
+                                       const glm::dvec3& b, const glm::dvec3& c);
+
+// Result of a closest-triangle query.
+struct TriangleHit {
+  uint32_t triangle = std::numeric_limits<uint32_t>::max();  // max(): none found
+  double distanceSquared = std::numeric_limits<double>::infinity();
+  glm::dvec3 point{0.0};
+  TriangleFeature feature = TriangleFeature::face;
+  bool found() const { return triangle != std::numeric_limits<uint32_t>::max(); }
+};
+
+class TriangleBvh {
+ public:
+  // count > 0: a leaf holding triangles order()[first, first + count).
+  // count == 0: an inner node whose children are nodes[first] and nodes[first + 1].
+  // Children always come after their parent in the array.
+  struct Node {
+    glm::vec3 min{0.0f};
+    uint32_t first = 0;
+    glm::vec3 max{0.0f};
+    uint32_t count = 0;
+  };
+
+  using Hit = TriangleHit;
+
+  // Builds over `indices` (three per triangle) into `positions`. The arrays must describe a
+  // valid mesh (validateMesh); they are not kept, only copied per triangle in leaf order.
+  void build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
+             uint32_t maxLeafSize = 4);
+
+  // New positions for the same triangles (same indices as build()): recomputes the node bounds
+  // bottom-up, O(n). The tree shape stays, so queries stay exact but may slow down after large
+  // deformations.
+  void refit(std::span<const glm::vec3> positions, std::span<const uint32_t> indices);
+
+  // Closest triangle to `p` among those nearer than sqrt(seed.distanceSquared); returns `seed`
+  // unchanged when none is. A default seed searches everything. A seed carrying a triangle must
+  // carry that triangle's exact distance (see evaluate()); ties keep the seed.
+  Hit closest(const glm::vec3& p, Hit seed = Hit{}) const;
+
+  // The exact hit record of `p` against one triangle (original index).
+  Hit evaluate(const glm::vec3& p, uint32_t triangle) const;
+
+  std::span<const Node> nodes() const { return nodes_; }
+  // Original triangle index of each leaf slot.
+  std::span<const uint32_t> order() const { return order_; }
+  struct Corners {
+    glm::vec3 a, b, c;
+  };
+  // Corner positions of each leaf slot (the triangle order()[slot]).
+  std::span<const Corners> corners() const { return corners_; }
+  size_t triangleCount() const { return order_.size(); }
+
+ private:
+  void refitNodes();
+
+  std::vector<Node> nodes_;
+  std::vector<uint32_t> order_;   // leaf slot -> original triangle
+  std::vector<uint32_t> slotOf_;  // original triangle -> leaf slot
+  std::vector<Corners> corners_;  // per leaf slot, so a leaf reads one contiguous run
+};
+
+}  // namespace sdfg

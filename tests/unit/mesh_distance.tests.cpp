@@ -1,0 +1,322 @@
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "distance_test_meshes.h"
+#include "mesh_distance.h"
+#include "triangle_bvh.h"
+
+using namespace sdfg;
+using namespace sdfg::test;
+
+namespace {
+
+std::unique_ptr<MeshDistance> makeDistance(const TriangleMesh& m) {
+  auto result = MeshDistance::create(m);
+  REQUIRE(result.ok());
+  return std::move(result).value();
+}
+
+// Points near the surface (a random vertex moved by up to `near` in any direction) and far from
+// it (uniform in the bounding box grown by half its diagonal).
+std::vector<glm::vec3> samplePoints(const TriangleMesh& m, size_t nearCount, size_t farCount,
+                                    float near, std::mt19937& rng) {
+  const Aabb box = computeBounds(m.positions);
+  const float diag = glm::length(box.extent());
+  std::uniform_int_distribution<size_t> vertex(0, m.positions.size() - 1);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::vector<glm::vec3> points;
+  for (size_t i = 0; i < nearCount; ++i) {
+    points.push_back(m.positions[m.indices[3 * (vertex(rng) % m.triangleCount())]] +
+                     near * glm::vec3(unit(rng), unit(rng), unit(rng)));
+  }
+  for (size_t i = 0; i < farCount; ++i) {
+    const glm::vec3 u(unit(rng), unit(rng), unit(rng));
+    points.push_back(box.center() + u * (box.extent() * 0.5f + 0.5f * diag));
+  }
+  return points;
+}
+
+void checkAgainstBruteForce(const TriangleMesh& m, size_t nearCount, size_t farCount,
+                            uint32_t seed) {
+  const auto distance = makeDistance(m);
+  std::mt19937 rng(seed);
+  const float diag = glm::length(computeBounds(m.positions).extent());
+  for (const glm::vec3& p : samplePoints(m, nearCount, farCount, 0.02f * diag, rng)) {
+    const double expected = bruteForceDistance(m, p);
+    const ClosestPoint c = distance->closest(p);
+    CAPTURE(p.x, p.y, p.z);
+    CHECK(c.distance == Approx(expected).margin(1e-7 * diag));
+    CHECK(glm::length(c.point - p) == Approx(expected).margin(1e-6 * diag));
+    CHECK(std::abs(distance->signedDistance(p)) == Approx(expected).margin(1e-7 * diag));
+  }
+}
+
+// Analytic signed distance of an axis-aligned box of half-extents h centred at the origin.
+float boxSdf(const glm::vec3& p, const glm::vec3& h) {
+  const glm::vec3 q = glm::abs(p) - h;
+  return glm::length(glm::max(q, glm::vec3(0.0f))) + std::min(std::max({q.x, q.y, q.z}), 0.0f);
+}
+
+}  // namespace
+
+TEST_CASE("closestPointOnTriangle names the closest feature", "[mesh_distance][triangle]") {
+  const glm::dvec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  const auto at = [&](double x, double y, double z) {
+    return closestPointOnTriangle(glm::dvec3(x, y, z), a, b, c);
+  };
+  SECTION("above the face the point is the foot of the perpendicular") {
+    const auto r = at(0.25, 0.25, 2.0);
+    CHECK(r.feature == TriangleFeature::face);
+    CHECK(r.distanceSquared == Approx(4.0));
+    CHECK(r.point.x == Approx(0.25));
+  }
+  SECTION("beyond each corner the corner itself") {
+    CHECK(at(-1, -1, 0.5).feature == TriangleFeature::vertex0);
+    CHECK(at(2, -0.5, 0).feature == TriangleFeature::vertex1);
+    CHECK(at(-0.5, 2, 0).feature == TriangleFeature::vertex2);
+    CHECK(at(2, -0.5, 0).distanceSquared == Approx(1.25));
+  }
+  SECTION("beside each edge a point on that edge") {
+    const auto ab = at(0.5, -1, 0);
+    CHECK(ab.feature == TriangleFeature::edge0);
+    CHECK(ab.point.x == Approx(0.5));
+    CHECK(at(1, 1, 0).feature == TriangleFeature::edge1);
+    CHECK(at(-1, 0.5, 0).feature == TriangleFeature::edge2);
+  }
+}
+
+TEST_CASE("MeshDistance rejects invalid meshes", "[mesh_distance]") {
+  TriangleMesh m = cubeMesh(0.05f);
+  SECTION("empty") {
+    CHECK_FALSE(MeshDistance::create(TriangleMesh{}).ok());
+  }
+  SECTION("index out of range") {
+    m.indices[4] = 99;
+    const auto r = MeshDistance::create(m);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().code == Status::invalid_argument);
+  }
+  SECTION("NaN vertex") {
+    m.positions[2].y = std::nanf("");
+    CHECK_FALSE(MeshDistance::create(m).ok());
+  }
+}
+
+TEST_CASE("MeshDistance knows closed from open meshes", "[mesh_distance]") {
+  TriangleMesh cube = cubeMesh(0.05f);
+  CHECK(makeDistance(cube)->isClosed());
+  CHECK(makeDistance(icosphereMesh(0.05f, 2))->isClosed());
+  cube.indices.resize(cube.indices.size() - 3);
+  CHECK_FALSE(makeDistance(cube)->isClosed());
+}
+
+TEST_CASE("Closest points match brute force on analytic meshes", "[mesh_distance]") {
+  SECTION("cube") {
+    checkAgainstBruteForce(cubeMesh(0.05f), 300, 200, 1);
+  }
+  SECTION("icosphere") {
+    checkAgainstBruteForce(icosphereMesh(0.05f, 3), 300, 200, 2);
+  }
+}
+
+TEST_CASE("Closest points match brute force on the shared test meshes", "[mesh_distance][shared]") {
+  const char* names[] = {"stanford-bunny.obj",
+                         "stanford-armadillo-100k.obj",
+                         "stanford-dragon-100k.obj",
+                         "igea-268k.obj",
+                         "torus.obj",
+                         "newell-teapot.obj",
+                         "stanford-armadillo-400k-subdiv.obj"};
+  for (const char* name : names) {
+    const TriangleMesh* m = normalizedSharedMesh(name);
+    if (m == nullptr) SDFG_SKIP(std::string("shared mesh missing: ") + name);
+    CAPTURE(name);
+    checkAgainstBruteForce(*m, 100, 50, 3);
+  }
+}
+
+TEST_CASE("Signed distance matches analytic shapes everywhere, deep inside too",
+          "[mesh_distance][sign]") {
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+
+  SECTION("box: exact, both signs") {
+    const float h = 0.05f;
+    const auto d = makeDistance(cubeMesh(h));
+    for (int i = 0; i < 2000; ++i) {
+      const glm::vec3 p = 2.0f * h * glm::vec3(unit(rng), unit(rng), unit(rng));
+      CAPTURE(p.x, p.y, p.z);
+      CHECK(d->signedDistance(p) == Approx(boxSdf(p, glm::vec3(h))).margin(1e-6));
+    }
+    CHECK(d->signedDistance(glm::vec3(0.0f)) == Approx(-h).margin(1e-7));
+  }
+
+  SECTION("sphere: within the tessellation error") {
+    const float r = 0.05f;
+    const TriangleMesh m = icosphereMesh(r, 4);
+    // The flat faces lie between the inscribed distance and r from the centre.
+    double inscribed = r;
+    for (size_t t = 0; t < m.triangleCount(); ++t) {
+      const glm::dvec3 a(m.positions[m.indices[3 * t]]), b(m.positions[m.indices[3 * t + 1]]),
+          c(m.positions[m.indices[3 * t + 2]]);
+      inscribed =
+          std::min(inscribed, std::abs(glm::dot(a, glm::normalize(glm::cross(b - a, c - a)))));
+    }
+    const double tolerance = r - inscribed + 1e-6;
+    const auto d = makeDistance(m);
+    for (int i = 0; i < 2000; ++i) {
+      const glm::vec3 p = 2.0f * r * glm::vec3(unit(rng), unit(rng), unit(rng));
+      CAPTURE(p.x, p.y, p.z);
+      CHECK(d->signedDistance(p) == Approx(glm::length(p) - r).margin(tolerance));
+    }
+    CHECK(d->signedDistance(glm::vec3(0.0f)) < -0.9f * r);
+  }
+}
+
+TEST_CASE("Winding number is 1 inside, 0 outside, and gives the sign on open meshes",
+          "[mesh_distance][winding]") {
+  const float r = 0.05f;
+  TriangleMesh sphere = icosphereMesh(r, 3);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+
+  SECTION("closed sphere") {
+    const auto d = makeDistance(sphere);
+    for (int i = 0; i < 500; ++i) {
+      const glm::vec3 p = 3.0f * r * glm::vec3(unit(rng), unit(rng), unit(rng));
+      const float len = glm::length(p);
+      if (std::abs(len - r) < 0.05f * r) continue;
+      CAPTURE(p.x, p.y, p.z);
+      CHECK(d->windingNumber(p) == Approx(len < r ? 1.0f : 0.0f).margin(2e-3));
+    }
+  }
+
+  SECTION("sphere with a hole: the sign still follows the surface away from the hole") {
+    // Drop the triangles around the top vertex (a cap of a few degrees).
+    TriangleMesh open;
+    open.positions = sphere.positions;
+    for (size_t t = 0; t < sphere.triangleCount(); ++t) {
+      bool cap = false;
+      for (int k = 0; k < 3; ++k) cap |= sphere.positions[sphere.indices[3 * t + k]].y > 0.97f * r;
+      if (!cap) {
+        open.indices.insert(open.indices.end(), sphere.indices.begin() + 3 * t,
+                            sphere.indices.begin() + 3 * t + 3);
+      }
+    }
+    REQUIRE(open.indices.size() < sphere.indices.size());
+    const auto d = makeDistance(open);
+    REQUIRE_FALSE(d->isClosed());
+    const float w = d->windingNumber(glm::vec3(0.0f, r, 0.0f));
+    CHECK(w > 0.2f);
+    CHECK(w < 0.8f);
+    for (int i = 0; i < 500; ++i) {
+      const glm::vec3 p = 2.0f * r * glm::vec3(unit(rng), unit(rng), unit(rng));
+      const float len = glm::length(p);
+      if (std::abs(len - r) < 0.1f * r || p.y > 0.5f * r) continue;
+      CAPTURE(p.x, p.y, p.z);
+      CHECK((d->signedDistance(p) < 0.0f) == (len < r));
+    }
+  }
+}
+
+TEST_CASE("Sign on the open bunny and teapot agrees with ray parity",
+          "[mesh_distance][sign][shared]") {
+  for (const char* name : {"stanford-bunny.obj", "newell-teapot.obj"}) {
+    const TriangleMesh* m = normalizedSharedMesh(name);
+    if (m == nullptr) SDFG_SKIP(std::string("shared mesh missing: ") + name);
+    CAPTURE(name);
+    const auto d = makeDistance(*m);
+    CHECK_FALSE(d->isClosed());
+    const Aabb box = computeBounds(m->positions);
+    std::mt19937 rng(6);
+    std::uniform_real_distribution<float> unit(-0.55f, 0.55f);
+    int inside = 0, outside = 0, judged = 0, disagree = 0;
+    for (int i = 0; i < 300; ++i) {
+      const glm::vec3 p = box.center() + glm::vec3(unit(rng), unit(rng), unit(rng)) * box.extent();
+      const float sd = d->signedDistance(p);
+      // "Well" inside or outside: away from the surface, and every ray agrees.
+      if (std::abs(sd) < 0.005f) continue;
+      const int vote = rayParityVote(*m, p, rng);
+      if (vote == 0) continue;
+      ++judged;
+      (vote > 0 ? inside : outside)++;
+      if ((sd < 0.0f) != (vote > 0)) {
+        ++disagree;
+        UNSCOPED_INFO("disagreement at " << p.x << " " << p.y << " " << p.z << " sd " << sd << " w "
+                                         << d->windingNumber(p));
+      }
+    }
+    CHECK(inside > 10);
+    CHECK(outside > 10);
+    CHECK(judged > 150);
+    CHECK(disagree == 0);
+  }
+}
+
+TEST_CASE("updatePositions gives the distances of a freshly created mesh",
+          "[mesh_distance][refit]") {
+  const Pose move{glm::angleAxis(0.7f, glm::normalize(glm::vec3(1, 2, 3))),
+                  glm::vec3(0.03f, -0.01f, 0.2f)};
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+
+  const auto compare = [&](const TriangleMesh& original) {
+    const auto d = makeDistance(original);
+    TriangleMesh moved = original;
+    transformMesh(moved, move, 1.7f);
+    REQUIRE(d->updatePositions(moved.positions) == Status::ok);
+    const auto fresh = makeDistance(moved);
+    const Aabb box = computeBounds(moved.positions);
+    for (int i = 0; i < 300; ++i) {
+      const glm::vec3 p = box.center() + glm::vec3(unit(rng), unit(rng), unit(rng)) * box.extent();
+      CAPTURE(p.x, p.y, p.z);
+      CHECK(d->signedDistance(p) == fresh->signedDistance(p));
+      CHECK(d->windingNumber(p) == Approx(fresh->windingNumber(p)).margin(1e-3));
+    }
+    CHECK(d->mesh().positions == moved.positions);
+  };
+  SECTION("closed sphere") {
+    compare(icosphereMesh(0.05f, 3));
+  }
+  SECTION("open cube") {
+    TriangleMesh cube = cubeMesh(0.05f);
+    cube.indices.resize(cube.indices.size() - 3);
+    compare(cube);
+  }
+
+  SECTION("bad updates are rejected and change nothing") {
+    const TriangleMesh m = icosphereMesh(0.05f, 2);
+    const auto d = makeDistance(m);
+    const glm::vec3 probe(0.01f, 0.02f, -0.03f);
+    const float before = d->signedDistance(probe);
+    std::vector<glm::vec3> wrongCount(m.positions.begin(), m.positions.end() - 1);
+    CHECK(d->updatePositions(wrongCount) == Status::invalid_argument);
+    std::vector<glm::vec3> nan = m.positions;
+    for (glm::vec3& p : nan) p *= 2.0f;
+    nan[5].z = std::numeric_limits<float>::infinity();
+    CHECK(d->updatePositions(nan) == Status::invalid_argument);
+    std::vector<glm::vec3> collapsed(m.positions.size(), glm::vec3(0.1f));
+    CHECK(d->updatePositions(collapsed) == Status::invalid_argument);
+    CHECK(d->signedDistance(probe) == before);
+    CHECK(d->mesh().positions == m.positions);
+  }
+}
+
+TEST_CASE("closestWithin honours its radius and hints never change the answer", "[mesh_distance]") {
+  const auto d = makeDistance(icosphereMesh(0.05f, 3));
+  const glm::vec3 p(0.0f, 0.0f, 0.08f);
+  const ClosestPoint full = d->closest(p);
+  CHECK(full.distance == Approx(0.03f).margin(5e-4));
+  CHECK(d->closestWithin(p, full.distance * 1.01f).distance == full.distance);
+  CHECK(std::isinf(d->closestWithin(p, full.distance * 0.99f).distance));
+  CHECK(std::isinf(d->closestWithin(p, -1.0f).distance));
+  const uint32_t triangles = uint32_t(d->mesh().triangleCount());
+  for (uint32_t hint : {0u, triangles / 2, triangles - 1, triangles, ~0u}) {
+    uint32_t closest = 0;
+    CHECK(d->signedDistanceNear(p, hint, &closest) == d->signedDistance(p));
+    CHECK(closest < triangles);
+  }
+}

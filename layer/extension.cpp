@@ -125,7 +125,8 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
     return logError(toXrResult(st), cmd, "the target could not be built (%s)", toString(st));
   s->targets[t->handle] = t;
   *target = fromKey<XrGraspTargetSDFG>(t->handle);
-  targets().insert(t->handle, std::move(t));
+  const uint64_t handle = t->handle;
+  targets().insert(handle, std::move(t));
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)
 }

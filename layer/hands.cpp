@@ -148,7 +148,10 @@ XrResult XRAPI_CALL SdfgXrCreateHandTrackerEXT(XrSession session,
     t->handle = key(*tracker);
     t->runtimeHandle = *tracker;
     t->hand = handOf(info->hand);
-    trackers().insert(t->handle, std::move(t));
+    {
+      const uint64_t handle = t->handle;
+      trackers().insert(handle, std::move(t));
+    }
     return r;
   }
   if (info == nullptr) return logError(XR_ERROR_VALIDATION_FAILURE, cmd, "(createInfo) is null");
@@ -166,7 +169,10 @@ XrResult XRAPI_CALL SdfgXrCreateHandTrackerEXT(XrSession session,
   t->handle = newLayerHandle();
   t->hand = handOf(info->hand);
   *tracker = fromKey<XrHandTrackerEXT>(t->handle);
-  trackers().insert(t->handle, std::move(t));
+  {
+    const uint64_t handle = t->handle;
+    trackers().insert(handle, std::move(t));
+  }
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)
 }

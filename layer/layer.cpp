@@ -25,24 +25,6 @@ constexpr OwnExtension kOwnExtensions[] = {
 
 XrResult XRAPI_CALL SdfgXrGetInstanceProcAddr(XrInstance, const char*, PFN_xrVoidFunction*);
 
-// Extension names the chain below offers (the runtime's, through the loader terminator).
-std::vector<std::string> runtimeExtensions(PFN_xrGetInstanceProcAddr nextGipa, bool& ok) {
-  std::vector<std::string> names;
-  ok = false;
-  PFN_xrEnumerateInstanceExtensionProperties enumerate = nullptr;
-  if (nextGipa(XR_NULL_HANDLE, "xrEnumerateInstanceExtensionProperties",
-               reinterpret_cast<PFN_xrVoidFunction*>(&enumerate)) != XR_SUCCESS ||
-      enumerate == nullptr)
-    return names;
-  uint32_t count = 0;
-  if (enumerate(nullptr, 0, &count, nullptr) != XR_SUCCESS) return names;
-  std::vector<XrExtensionProperties> props(count, {XR_TYPE_EXTENSION_PROPERTIES});
-  if (enumerate(nullptr, count, &count, props.data()) != XR_SUCCESS) return names;
-  for (uint32_t i = 0; i < count; ++i) names.emplace_back(props[i].extensionName);
-  ok = true;
-  return names;
-}
-
 bool contains(const std::vector<std::string>& list, const char* name) {
   for (const auto& s : list) {
     if (s == name) return true;
@@ -95,37 +77,47 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
   state->appMotionRange = contains(appExtensions, XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME);
   state->appDebugUtils = contains(appExtensions, XR_EXT_DEBUG_UTILS_EXTENSION_NAME);
 
-  bool queried = false;
-  const std::vector<std::string> offered = runtimeExtensions(state->nextGipa, queried);
-  if (!queried) SDFG_LOG_WARN(cmd, "could not list the runtime's extensions; assuming it has all");
-  state->runtimeHandTracking = !queried || contains(offered, XR_EXT_HAND_TRACKING_EXTENSION_NAME);
-  state->runtimeMotionRange =
-      !queried || contains(offered, XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME);
-  state->provideHandTracking = state->appHandTracking && !state->runtimeHandTracking;
-  state->stripMotionRange = state->appMotionRange && !state->runtimeMotionRange;
-  state->downstreamHandTracking =
-      state->runtimeHandTracking && (state->appHandTracking || state->appAutoGrasp);
-  state->active = state->appAutoGrasp || state->provideHandTracking || state->stripMotionRange;
-
-  // What goes down: the app's list without the layer's own extensions (the runtime would answer
-  // XR_ERROR_EXTENSION_NOT_PRESENT), plus hand tracking when grasping needs it from the runtime.
-  std::vector<const char*> down;
-  for (const std::string& name : appExtensions) {
-    if (name == XR_SDFG_AUTO_GRASP_EXTENSION_NAME) continue;
-    if (name == XR_EXT_HAND_TRACKING_EXTENSION_NAME && state->provideHandTracking) continue;
-    if (name == XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME && state->stripMotionRange) continue;
-    down.push_back(name.c_str());
-  }
-  if (state->downstreamHandTracking && !state->appHandTracking)
-    down.push_back(XR_EXT_HAND_TRACKING_EXTENSION_NAME);
-  XrInstanceCreateInfo downInfo = *info;
-  downInfo.enabledExtensionCount = uint32_t(down.size());
-  downInfo.enabledExtensionNames = down.empty() ? nullptr : down.data();
-
+  // The runtime's extensions cannot be listed from here: layers below (core validation 1.0.20)
+  // refuse xrEnumerateInstanceExtensionProperties without an instance. So ask by trying, as
+  // HTCC does: the full list first, then without motion range, then without hand tracking, each
+  // retried only when the chain refuses the list.
+  const bool wantHandTracking = state->appHandTracking || state->appAutoGrasp;
   XrApiLayerCreateInfo downLayerInfo = *layerInfo;
   downLayerInfo.nextInfo = nextInfo->next;
-  const XrResult r = nextInfo->nextCreateApiLayerInstance(&downInfo, &downLayerInfo, instance);
+  // Core validation 1.0.20 reports the runtime's refusal as XR_ERROR_INITIALIZATION_FAILED.
+  auto refused = [](XrResult res) {
+    return res == XR_ERROR_EXTENSION_NOT_PRESENT || res == XR_ERROR_INITIALIZATION_FAILED;
+  };
+  XrResult r = XR_ERROR_EXTENSION_NOT_PRESENT;
+  for (int attempt = 0; attempt < 3 && refused(r); ++attempt) {
+    const bool withMotionRange = attempt == 0;
+    const bool withHandTracking = attempt < 2;
+    if (attempt == 1 && !state->appMotionRange) continue;
+    if (attempt == 2 && !wantHandTracking) break;
+    state->runtimeHandTracking = withHandTracking;
+    state->runtimeMotionRange = withMotionRange;
+    state->provideHandTracking = state->appHandTracking && !withHandTracking;
+    state->stripMotionRange = state->appMotionRange && !withMotionRange;
+    state->downstreamHandTracking = withHandTracking && wantHandTracking;
+    // What goes down: the app's list without the layer's own extensions (the runtime would
+    // answer XR_ERROR_EXTENSION_NOT_PRESENT), plus hand tracking when grasping wants it.
+    std::vector<const char*> down;
+    for (const std::string& name : appExtensions) {
+      if (name == XR_SDFG_AUTO_GRASP_EXTENSION_NAME) continue;
+      if (name == XR_EXT_HAND_TRACKING_EXTENSION_NAME) continue;
+      if (name == XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME && !withMotionRange) continue;
+      down.push_back(name.c_str());
+    }
+    if (state->downstreamHandTracking) down.push_back(XR_EXT_HAND_TRACKING_EXTENSION_NAME);
+    XrInstanceCreateInfo downInfo = *info;
+    downInfo.enabledExtensionCount = uint32_t(down.size());
+    downInfo.enabledExtensionNames = down.empty() ? nullptr : down.data();
+    r = nextInfo->nextCreateApiLayerInstance(&downInfo, &downLayerInfo, instance);
+    SDFG_LOG_INFO(cmd, "create with hand tracking %d, motion range %d: %d", withHandTracking,
+                  withMotionRange, int(r));
+  }
   if (XR_FAILED(r)) return r;
+  state->active = state->appAutoGrasp || state->provideHandTracking || state->stripMotionRange;
 
   state->handle = *instance;
   state->next.load(state->nextGipa, *instance);

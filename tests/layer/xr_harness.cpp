@@ -151,10 +151,14 @@ void App::pollEvents() {
 void App::frame() {
   pollEvents();
   if (!running_) return;
+  // Info structs passed although they may be null: the mock runtime's null check is broken
+  // (frame.cpp: `if (info) MOCK_VERIFY_TYPE(...)` guards only the macro's first statement).
   XrFrameState fs{XR_TYPE_FRAME_STATE};
-  if (xrWaitFrame(session, nullptr, &fs) != XR_SUCCESS) return;
+  XrFrameWaitInfo wi{XR_TYPE_FRAME_WAIT_INFO};
+  if (xrWaitFrame(session, &wi, &fs) != XR_SUCCESS) return;
   lastTime = fs.predictedDisplayTime;
-  xrBeginFrame(session, nullptr);
+  XrFrameBeginInfo bi{XR_TYPE_FRAME_BEGIN_INFO};
+  xrBeginFrame(session, &bi);
   if (appSet != XR_NULL_HANDLE) {
     XrActiveActionSet active{appSet, XR_NULL_PATH};
     XrActionsSyncInfo si{XR_TYPE_ACTIONS_SYNC_INFO};

@@ -3,6 +3,7 @@
 // xrLocateHandJointsEXT and checked against the exact distance to the object.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -284,5 +285,76 @@ TEST_CASE("Releasing the squeeze ends the grasp", "[layer][grasp]") {
   app.frames(5);
   REQUIRE(ext.state(app.session, &gi, &st) == XR_SUCCESS);
   CHECK_FALSE(st.isGrasping);
+  CHECK(validationLog().empty());
+}
+
+TEST_CASE("With runtime hand tracking, a grasp never moves a finger the user holds more open",
+          "[layer][grasp][passthrough]") {
+  // The mock runtime's tracked hand is flat and open, its wrist at the grip pose: the user's
+  // curl (0) is below every contact curl, so the held grasp leaves every joint untouched.
+  const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+  XrEnv env;
+  env.script = gripLine(0, "right", grip) + squeezeLine(0, "right", 0.0f) +
+               squeezeLine(4, "right", 0.0f) + squeezeLine(6, "right", 1.0f);
+  env.layer = false;
+  applyEnv(env);
+  auto run = [&](bool withTarget, XrGraspStateSDFG* state) {
+    App app({withTarget ? std::vector<std::string>{XR_EXT_HAND_TRACKING_EXTENSION_NAME,
+                                                   XR_SDFG_AUTO_GRASP_EXTENSION_NAME}
+                        : std::vector<std::string>{XR_EXT_HAND_TRACKING_EXTENSION_NAME}});
+    REQUIRE(app.ok());
+    Ext ext(app);
+    XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
+    if (withTarget) {
+      // The grab box of a tracked hand hangs below its wrist joint (hand space (0, -7.5, -8.1) cm).
+      const XrVector3f c{grip.position.x, grip.position.y - 0.075f, grip.position.z - 0.081f};
+      makeTarget(app, ext, makeIcosphere(0.04f, 3), {{0, 0, 0, 1}, c});
+    }
+    app.frames(12);
+    Joints j;
+    REQUIRE(locateJoints(app, tracker, j) == XR_SUCCESS);
+    if (withTarget) {
+      XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
+      REQUIRE(ext.state(app.session, &gi, state) == XR_SUCCESS);
+    }
+    return j;
+  };
+  XrGraspStateSDFG state{XR_TYPE_GRASP_STATE_SDFG};
+  const Joints runtime = run(false, nullptr);
+  env.layer = true;
+  applyEnv(env);
+  const Joints layered = run(true, &state);
+  CHECK(state.isGrasping);  // a grasp is held...
+  // ...and the open fingers are the runtime's, bit for bit.
+  CHECK(std::memcmp(runtime.joints.data(), layered.joints.data(), sizeof(runtime.joints)) == 0);
+  CHECK(validationLog().empty());
+}
+
+TEST_CASE("Destroying the session while a hand holds a target releases everything",
+          "[layer][grasp]") {
+  XrEnv env;
+  env.handTracking = "absent";
+  const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+  env.script = gripLine(0, "right", grip) + squeezeLine(0, "right", 0.0f) +
+               squeezeLine(4, "right", 0.0f) + squeezeLine(6, "right", 1.0f);
+  applyEnv(env);
+  App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}});
+  REQUIRE(app.ok());
+  Ext ext(app);
+  XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
+  XrGraspTargetSDFG target =
+      makeTarget(app, ext, makeIcosphere(0.04f, 3), {{0, 0, 0, 1}, boxCentreInLocal(grip, true)});
+  app.frames(10);
+  XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
+  XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG};
+  REQUIRE(ext.state(app.session, &gi, &st) == XR_SUCCESS);
+  REQUIRE(st.isGrasping);
+  const XrSession old = app.session;
+  app.destroySession();
+  // The session's children went with it.
+  CHECK(ext.destroy(target) == XR_ERROR_HANDLE_INVALID);
+  CHECK(ext.state(old, &gi, &st) == XR_ERROR_HANDLE_INVALID);
+  Joints j;
+  CHECK(locateJoints(app, tracker, j) == XR_ERROR_HANDLE_INVALID);
   CHECK(validationLog().empty());
 }

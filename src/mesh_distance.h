@@ -47,7 +47,8 @@ class MeshDistance {
   float signedDistance(const glm::vec3& p) const;
   // signedDistance(p) seeded with a triangle likely to be near `p` (in a sweep over grid nodes,
   // the previous node's closest triangle): its exact distance bounds the search, so far less of
-  // the hierarchy is visited. Same value as signedDistance(p) whatever the hint; a hint out of
+  // the hierarchy is visited. Same distance as signedDistance(p) whatever the hint (the sign too,
+  // except where two features are exactly equally close); a hint out of
   // range is ignored. Writes the closest triangle to *closestTriangle when it is not null.
   float signedDistanceNear(const glm::vec3& p, uint32_t hintTriangle,
                            uint32_t* closestTriangle = nullptr) const;

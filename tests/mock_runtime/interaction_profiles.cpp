@@ -68,7 +68,7 @@ const Profile* findProfile(const std::string& path) {
 }
 
 // Scalar from the script, with the fallbacks a real device has: a click reads as value > 0.5
-// when only the value is scripted, and a value reads the click when only that is scripted.
+// when only the value is scripted, a force reads the value, and a value reads the click.
 float readComponent(const Session& session, Target hand, const std::string& identifier,
                     const std::string& component) {
   const Script& script = session.instance->script;
@@ -76,6 +76,9 @@ float readComponent(const Session& session, Target hand, const std::string& iden
   if (auto v = script.scalar(hand, identifier + "/" + component, f)) return *v;
   if (component == "click") {
     if (auto v = script.scalar(hand, identifier + "/value", f)) return *v > 0.5f ? 1.0f : 0.0f;
+  }
+  if (component == "force") {  // a squeeze force reads the squeeze value when only that is scripted
+    if (auto v = script.scalar(hand, identifier + "/value", f)) return *v;
   }
   if (component == "value") {
     if (auto v = script.scalar(hand, identifier + "/click", f)) return *v;

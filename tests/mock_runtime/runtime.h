@@ -38,14 +38,19 @@ namespace sdfg::mock {
 XrResult fail(const char* cmd, XrResult result, const char* fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
-#define MOCK_VERIFY_NOT_NULL(cmd, arg) \
-  if ((arg) == nullptr) return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "(" #arg ") is null")
+// Single statements (do/while), so they are safe under an unbraced `if`.
+#define MOCK_VERIFY_NOT_NULL(cmd, arg)                                                         \
+  do {                                                                                         \
+    if ((arg) == nullptr) return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "(" #arg ") is null"); \
+  } while (false)
 
-#define MOCK_VERIFY_TYPE(cmd, arg, expected)                                                   \
-  MOCK_VERIFY_NOT_NULL(cmd, arg);                                                              \
-  if ((arg)->type != (expected))                                                               \
-  return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "(" #arg "->type) is %d, expected " #expected, \
-              int((arg)->type))
+#define MOCK_VERIFY_TYPE(cmd, arg, expected)                                                       \
+  do {                                                                                             \
+    if ((arg) == nullptr) return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "(" #arg ") is null");     \
+    if ((arg)->type != (expected))                                                                 \
+      return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "(" #arg "->type) is %d, expected " #expected, \
+                  int((arg)->type));                                                               \
+  } while (false)
 
 // ---- handles -------------------------------------------------------------------------------
 

@@ -199,7 +199,7 @@ std::vector<float> Script::sample(const Track& track, uint64_t frame, bool pose)
   const auto& keys = track.keys;
   auto next = std::upper_bound(keys.begin(), keys.end(), frame,
                                [](uint64_t f, const Key& k) { return f < k.frame; });
-  if (next == keys.begin()) return keys.front().values;
+  if (next == keys.begin()) return track.step ? std::vector<float>{} : keys.front().values;
   if (next == keys.end() || track.step) return std::prev(next)->values;
   const Key& a = *std::prev(next);
   const Key& b = *next;
@@ -224,19 +224,23 @@ std::optional<XrPosef> Script::pose(Target target, std::string_view channel, uin
   const Track* track = find(target, name);
   if (track == nullptr) return std::nullopt;
   const std::vector<float> v = sample(*track, frame, true);
+  if (v.empty()) return std::nullopt;
   return XrPosef{{v[3], v[4], v[5], v[6]}, {v[0], v[1], v[2]}};
 }
 
 std::optional<float> Script::scalar(Target target, std::string_view channel, uint64_t frame) const {
   const Track* track = find(target, channel);
   if (track == nullptr) return std::nullopt;
-  return sample(*track, frame, false)[0];
+  const std::vector<float> v = sample(*track, frame, false);
+  if (v.empty()) return std::nullopt;
+  return v[0];
 }
 
 std::optional<JointSet> Script::joints(Target target, uint64_t frame) const {
   const Track* track = find(target, "joints");
   if (track == nullptr) return std::nullopt;
   const std::vector<float> v = sample(*track, frame, true);
+  if (v.empty()) return std::nullopt;
   JointSet set;
   for (uint32_t j = 0; j < kJointCount; ++j) {
     const float* f = &v[size_t{j} * kFloatsPerJoint];

@@ -2,10 +2,11 @@
 // hand, head) and channel (grip pose, squeeze value, joints...), parsed from text and sampled
 // at a frame index. The format is documented in docs/mock-runtime.md.
 //
-// Sampling rules: before the first keyframe of a channel its first value holds, after the last
-// its last value holds; in between, channels ending in /click or /touch and the tracked flags
-// step (hold the earlier keyframe), everything else interpolates linearly (orientations by
-// normalised lerp along the shorter arc).
+// Sampling rules: channels ending in /click or /touch and the tracked flags are steps: each
+// keyframe holds until the next, and before the first one the channel has its default ("8 left
+// tracked 0" loses the hand from frame 8 on). Every other channel interpolates linearly between
+// keyframes (orientations by normalised lerp along the shorter arc) and holds its first value
+// before the first keyframe and its last value after the last.
 #pragma once
 
 #include <openxr/openxr.h>
@@ -58,6 +59,7 @@ class Script {
     std::vector<Key> keys;  // sorted by frame
   };
   const Track* find(Target target, std::string_view channel) const;
+  // Empty when a step track is sampled before its first keyframe.
   static std::vector<float> sample(const Track& track, uint64_t frame, bool pose);
 
   std::map<std::pair<int, std::string>, Track> tracks_;

@@ -5,10 +5,8 @@
 #include <openxr/openxr.h>
 
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -16,7 +14,9 @@
 #include "hand_synthesis.h"
 #include "mesh.h"
 #include "mesh_distance.h"
+#include "mesh_io.h"
 #include "sdf_grid.h"
+#include "shapes.h"
 #include "test_support.h"
 
 namespace sdfg::test {
@@ -40,32 +40,17 @@ inline XrVector3f boxCentreInLocal(const XrPosef& grip, bool right) {
   return {c.x, c.y, c.z};
 }
 
-// Octahedron subdivided `levels` times, projected onto the sphere.
+// A core mesh in OpenXR types.
+inline TestMesh toTestMesh(const TriangleMesh& m) {
+  TestMesh out;
+  for (const glm::vec3& p : m.positions) out.vertices.push_back({p.x, p.y, p.z});
+  out.indices = m.indices;
+  return out;
+}
+
+// A sphere (the core's subdivided icosahedron) of `radius`.
 inline TestMesh makeIcosphere(float radius, int levels) {
-  std::vector<glm::vec3> v = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  std::vector<uint32_t> f = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4,
-                             2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5};
-  for (int l = 0; l < levels; ++l) {
-    std::vector<uint32_t> next;
-    std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
-    auto midpoint = [&](uint32_t a, uint32_t b) {
-      auto k = std::minmax(a, b);
-      auto it = mid.find(k);
-      if (it != mid.end()) return it->second;
-      v.push_back(glm::normalize(v[a] + v[b]));
-      return mid[k] = uint32_t(v.size() - 1);
-    };
-    for (size_t t = 0; t < f.size(); t += 3) {
-      const uint32_t a = f[t], b = f[t + 1], c = f[t + 2];
-      const uint32_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
-      next.insert(next.end(), {a, ab, ca, ab, b, bc, ca, bc, c, ab, bc, ca});
-    }
-    f = next;
-  }
-  TestMesh m;
-  for (const auto& p : v) m.vertices.push_back({p.x * radius, p.y * radius, p.z * radius});
-  m.indices = f;
-  return m;
+  return toTestMesh(makeSphere(radius, levels));
 }
 
 // Torus around the Z axis.
@@ -95,30 +80,14 @@ inline float torusDistance(const XrPosef& pose, float major, float minor, const 
   return std::sqrt(rho * rho + q.z * q.z) - minor;
 }
 
-// Reads "v" and "f" lines of an OBJ under ../shared/meshes; false when it is absent.
+// Loads a mesh under ../shared/meshes with the core's loader; false when it is absent.
 inline bool loadSharedObj(const char* name, TestMesh& out) {
   const auto path = sharedMesh(name);
   if (!path) return false;
-  std::ifstream in(*path);
-  if (!in) return false;
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream s(line);
-    std::string tag;
-    s >> tag;
-    if (tag == "v") {
-      XrVector3f v;
-      s >> v.x >> v.y >> v.z;
-      out.vertices.push_back(v);
-    } else if (tag == "f") {
-      std::vector<uint32_t> face;
-      std::string w;
-      while (s >> w) face.push_back(uint32_t(std::stoul(w.substr(0, w.find('/')))) - 1);
-      for (size_t k = 1; k + 1 < face.size(); ++k)
-        out.indices.insert(out.indices.end(), {face[0], face[k], face[k + 1]});
-    }
-  }
-  return !out.indices.empty();
+  auto loaded = loadMesh(*path);
+  if (!loaded) return false;
+  out = toTestMesh(loaded->mesh);
+  return true;
 }
 
 inline void centreMesh(TestMesh& m) {

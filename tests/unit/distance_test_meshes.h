@@ -22,10 +22,14 @@
 namespace sdfg::test {
 
 // Axis-aligned cube of half-extent `h`, 12 outward counter-clockwise triangles.
-inline TriangleMesh cubeMesh(float h) { return makeBox(glm::vec3(2.0f * h)); }
+inline TriangleMesh cubeMesh(float h) {
+  return makeBox(glm::vec3(2.0f * h));
+}
 
 // Icosahedron subdivided `levels` times, vertices on the sphere of `radius`.
-inline TriangleMesh icosphereMesh(float radius, int levels) { return makeSphere(radius, levels); }
+inline TriangleMesh icosphereMesh(float radius, int levels) {
+  return makeSphere(radius, levels);
+}
 
 // A shared mesh scaled to a 0.18 m bounding-box diagonal and centred, as the benchmark uses
 // them; loaded once per process. Nothing when the shared meshes are absent.

@@ -269,16 +269,18 @@ int main(int argc, char** argv) {
   for (size_t i = 0; i < candidates.size(); ++i) {
     Candidate& c = candidates[i];
     const size_t index = i + 1, count = candidates.size();
-    auto fail = [&](const std::string& why) {
-      progress.note("skipping " + c.origin + ": " + why);
-      info.failures.push_back(c.origin + ": " + why);
+    // `why` names the file itself when it comes from loadMesh (its messages start with it).
+    auto fail = [&](const std::string& why, bool namesFile = false) {
+      const std::string what = namesFile ? why : c.origin + ": " + why;
+      progress.note("skipping " + what);
+      info.failures.push_back(what);
       anyFailure = true;
     };
     if (!c.path.empty()) {
       progress.step(index, count, c.name, "loading");
       auto loaded = loadMesh(c.path);
       if (!loaded) {
-        fail(loaded.error().message);
+        fail(loaded.error().message, /*namesFile=*/true);
         continue;
       }
       c.mesh = normalizedToDiagonal(loaded->mesh, kHandSizedDiagonal);

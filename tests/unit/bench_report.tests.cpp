@@ -40,7 +40,9 @@ TEST_CASE("The report renders every JSON metric, known or not", "[bench][report]
     {"mesh": "cube", "triangles": 12, "method": "ours", "sdf_backend": "cpu", "grasps": 2,
      "sdf_build_ms": {"median": 1.5, "p95": 2}, "solve_us": {"median": 40, "p95": 50},
      "tip_residual_mm": {"median": 0.5, "p95": 0.75}, "contact_residual_mm": {"median": 0.0625},
-     "pass_through": 0}]})";
+     "pass_through": 0},
+    {"mesh": "cube", "triangles": 12, "method": "paper", "sdf_backend": "cpu", "grasps": 1,
+     "solve_us": {"median": 9, "p95": 9}, "pass_through": 1}]})";
   sdfg::bench::ReportRequest request;
   request.dir = dir / "out";
   request.resultsJson = json;
@@ -63,10 +65,17 @@ TEST_CASE("The report renders every JSON metric, known or not", "[bench][report]
     CHECK(md.find("| cube | ours | 2 | 0.5 | 0.75 | 0.0625 | 0 |") != std::string::npos);
     CHECK(md.find("text is not a column") == std::string::npos);
   }
+  SECTION("a second mesh of the same name gets its own column") {
+    CHECK(md.find("| method | cube | cube (2) |") != std::string::npos);
+    CHECK(md.find("| paper | 2.25 | 9 |") != std::string::npos);
+    CHECK(md.find("| ours | 40 | - |") != std::string::npos);
+    CHECK(md.find("| cube (2) | paper | 1 |") != std::string::npos);
+  }
   SECTION("each metric gets a data file for its figure") {
     CHECK(fs::exists(request.dir / "bench-data" / "contact_residual_mm.dat"));
     const std::string dat = readAll(request.dir / "bench-data" / "pass_through.dat");
     CHECK(dat.find("\"cube\" 3 0") != std::string::npos);
+    CHECK(dat.find("\"cube (2)\" 1 NaN") != std::string::npos);
     CHECK(md.find("img/bench/pass_through.png") != std::string::npos);
   }
 }

@@ -597,14 +597,18 @@ std::string linePlot(const std::string& dat, const std::string& png, const std::
      << "set title " << gpString(title) << "\nset xlabel " << gpString(xlabel) << "\n"
      << "set ylabel 'build time per grab (ms)'\nset logscale y\n"
      << (logX ? "set logscale x\nset format x '%.0s%c'\n" : "") << "set key left top\n"
-     << "set grid xtics lc rgb '#dddddd'\nset offsets graph 0.05, graph 0.08, graph 0.1, 0\n"
+     << "set grid xtics lc rgb '#dddddd'\n"
      << "plot ";
   for (size_t i = 0; i < builders.size(); ++i) {
     gp << (i ? ", " : "") << gpString(dat) << " using 2:" << 3 + i
        << " with linespoints lw 2 pt 7 title " << gpString(builders[i]);
   }
   if (labels) {
-    gp << ", " << gpString(dat) << " using 2:3:1 with labels offset 0,1 font 'sans,8' notitle";
+    // Names alternate above and below their points: meshes of equal size (100k) stay legible.
+    gp << ", " << gpString(dat)
+       << " using 2:(int($0) % 2 == 0 ? $3 : NaN):1 with labels offset 0,1 font 'sans,8' notitle"
+       << ", " << gpString(dat)
+       << " using 2:(int($0) % 2 == 1 ? $3 : NaN):1 with labels offset 0,-1 font 'sans,8' notitle";
   }
   gp << "\n";
   return gp.str();
@@ -644,8 +648,12 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
   const std::vector<std::string> identity = {"mesh",      "method",   "sdf_backend",
                                              "triangles", "solve_us", "sdf_build_ms"};
   for (const Json& row : *rowsJson->array()) {
-    const std::string mesh = row.find("mesh") ? row.find("mesh")->string() : "";
+    std::string mesh = row.find("mesh") ? row.find("mesh")->string() : "";
     const std::string method = row.find("method") ? row.find("method")->string() : "";
+    // Two meshes of one name (the embedded torus and torus.obj): the later one is "name (2)".
+    for (int n = 2; table.at(mesh, method); ++n) {
+      mesh = (row.find("mesh") ? row.find("mesh")->string() : "") + " (" + std::to_string(n) + ")";
+    }
     if (std::find(table.meshes.begin(), table.meshes.end(), mesh) == table.meshes.end()) {
       table.meshes.push_back(mesh);
     }
@@ -835,13 +843,26 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
       }
       return std::nullopt;
     };
+    // Log x axes: a margin keeps end points and labels off the border.
+    auto xrange = [](const std::vector<ScalingPoint>& points, bool byTriangles) {
+      double lo = 1e300, hi = 0.0;
+      for (const ScalingPoint& p : points) {
+        const double x = byTriangles ? double(p.triangles) : double(p.resolution);
+        lo = std::min(lo, x);
+        hi = std::max(hi, x);
+      }
+      // Labels are centred on their points: the right end needs more room than the left.
+      const double right = byTriangles ? 2.5 : 1.4;
+      return "set xrange [" + datNumber(lo / 1.4) + ":" + datNumber(hi * right) + "]\n";
+    };
     if (auto e = writeDat(s.byTriangles, "sdf_build_triangles", true)) return e;
     if (auto e = writeDat(s.byResolution, "sdf_build_resolution", false)) return e;
     if (!s.byTriangles.empty()) {
       gpAll << linePlot("sdf_build_triangles.dat", "../img/bench/sdf_build_triangles.png",
                         "Grab-box SDF build time against triangle count (" +
                             std::to_string(s.byTriangles.front().resolution) + "^3 nodes)",
-                        "triangles (log scale)", s.builders, true, true);
+                        "triangles (log scale)", s.builders, true, true,
+                        xrange(s.byTriangles, true));
       md << "![SDF build time against triangles](img/bench/sdf_build_triangles.png)\n\n";
     }
     if (!s.byResolution.empty()) {
@@ -849,7 +870,7 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
       for (size_t i = 0; i < s.byResolution.size(); ++i) {
         xtics += (i ? ", " : "") + std::to_string(s.byResolution[i].resolution);
       }
-      xtics += ")\n";
+      xtics += ")\n" + xrange(s.byResolution, false);
       gpAll << linePlot("sdf_build_resolution.dat", "../img/bench/sdf_build_resolution.png",
                         "Grab-box SDF build time against resolution (" +
                             s.byResolution.front().mesh + ", " +

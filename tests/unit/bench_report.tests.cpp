@@ -43,6 +43,8 @@ TEST_CASE("The report renders every JSON metric, known or not", "[bench][report]
      "pass_through": 0},
     {"mesh": "cube", "triangles": 12, "method": "paper", "sdf_backend": "cpu", "grasps": 1,
      "solve_us": {"median": 9, "p95": 9}, "pass_through": 1}]})";
+  fs::create_directories(dir / "out");
+  std::ofstream(dir / "out" / "benchmarks-notes.md") << "## Notes\n\nWritten by hand.\n";
   sdfg::bench::ReportRequest request;
   request.dir = dir / "out";
   request.resultsJson = json;
@@ -64,6 +66,10 @@ TEST_CASE("The report renders every JSON metric, known or not", "[bench][report]
     CHECK(md.find("| cube | paper | 2 | - | - | 0.125 | 3 |") != std::string::npos);
     CHECK(md.find("| cube | ours | 2 | 0.5 | 0.75 | 0.0625 | 0 |") != std::string::npos);
     CHECK(md.find("text is not a column") == std::string::npos);
+  }
+  SECTION("the hand-written notes are copied in at the end") {
+    CHECK(md.find("## Notes\n\nWritten by hand.\n") != std::string::npos);
+    CHECK(md.find("## Notes") > md.find("## Quality"));
   }
   SECTION("a second mesh of the same name gets its own column") {
     CHECK(md.find("| method | cube | cube (2) |") != std::string::npos);

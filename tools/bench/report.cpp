@@ -686,7 +686,8 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
   std::ostringstream md;
   md << "# Benchmarks: `autograsp-bench`\n\n"
      << "This file and the plots in `img/bench/` are written by `autograsp-bench --report` "
-        "from one run; edit the program, not this file. The command:\n\n```sh\n"
+        "from one run; edit the program (or `benchmarks-notes.md`, copied in at the end), not "
+        "this file. The command:\n\n```sh\n"
      << request.commandLine << "\n```\n\n";
   const std::string cpu = firstLineOf("/proc/cpuinfo", "model name");
   std::string load;
@@ -903,6 +904,13 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
   }
   md << "The data behind the plots: `bench-data/` (the bench's JSON, one `.dat` per figure and "
         "the gnuplot script `plots.gp`).\n";
+  // Written-by-hand analysis survives regeneration: it lives in its own file, copied in here.
+  const fs::path notes = request.dir / "benchmarks-notes.md";
+  if (std::ifstream notesIn{notes}) {
+    std::stringstream text;
+    text << notesIn.rdbuf();
+    md << "\n<!-- from benchmarks-notes.md -->\n\n" << text.str();
+  }
 
   const fs::path mdPath = request.dir / "benchmarks.md";
   if (!writeFile(mdPath, md.str())) {

@@ -54,8 +54,9 @@ TEST_CASE("The report renders every JSON metric, known or not", "[bench][report]
   const std::string md = readAll(request.dir / "benchmarks.md");
   REQUIRE_FALSE(md.empty());
 
-  SECTION("the command and the speed table") {
+  SECTION("the command, the settings and the speed table") {
     CHECK(md.find("autograsp-bench --report out") != std::string::npos);
+    CHECK(md.find("| run settings | placements 2, seed 7 |") != std::string::npos);
     CHECK(md.find("| paper | 2.25 |") != std::string::npos);
     CHECK(md.find("| ours | 40 |") != std::string::npos);
     CHECK(md.find("| CPU SDF build (ms) | 1.5 |") != std::string::npos);

@@ -682,7 +682,12 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
     }
   }
 
-  const int placements = json->find("placements") ? int(json->find("placements")->number()) : 0;
+  // Every top-level number of the JSON (placements, seed, da, resolution...) as "key value".
+  std::string settings;
+  for (const auto& [key, value] : *json->object()) {
+    if (value.isNumber())
+      settings += (settings.empty() ? "" : ", ") + key + " " + fmt(value.number());
+  }
   std::ostringstream md;
   md << "# Benchmarks: `autograsp-bench`\n\n"
      << "This file and the plots in `img/bench/` are written by `autograsp-bench --report` "
@@ -709,8 +714,7 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
       "unknown"
 #endif
      << " |\n"
-     << "| placements per mesh, seed | " << placements << ", "
-     << (json->find("seed") ? fmt(json->find("seed")->number()) : "-") << " |\n\n"
+     << "| run settings | " << settings << " |\n\n"
      << "Times are wall-clock and depend on the machine and on what else ran on it; the load "
         "average above says how busy it was.\n\n";
 

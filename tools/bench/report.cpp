@@ -718,19 +718,32 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
      << "Times are wall-clock and depend on the machine and on what else ran on it; the load "
         "average above says how busy it was.\n\n";
 
-  md << "## What is measured\n\n"
-     << "Every mesh is scaled to an 18 cm bounding-box diagonal (hand size). Seeded hand "
-        "placements (`src/placements.h`) put the open palm 1 to 4 cm from a random surface "
-        "point; every method solves the same placements. `solve_us`: per-solve time, minimum "
-        "over repeated batches, SDF build not included (as in the paper's Table 1). "
-        "`sdf_build_ms`: the CPU grab-box SDF build per placement, for the methods that read a "
-        "field. Quality is graded against CGAL's exact distance to the original surface "
-        "(`src/evaluator.h`): `tip_residual_mm` |d(tip) - r_tip| over fingers in contact; "
-        "`penetration_mm` deepest phalanx point inside the mesh per grasp; `early_stops` "
-        "fingers (summed over grasps) that stopped more than 5 mm short of a reachable pose; "
-        "`contacts_mean` fingers within 2 mm per grasp. Any other column is a metric of the "
-        "JSON documented in `src/evaluator.h`. `-`: no data (e.g. no finger in contact, no "
-        "field for a physics method).\n\n";
+  // Written-by-hand text survives regeneration: it lives in its own file, copied in at the end;
+  // when it is there it holds the definitions, else a short version goes here.
+  std::string notes;
+  if (std::ifstream notesIn{request.dir / "benchmarks-notes.md"}) {
+    std::stringstream text;
+    text << notesIn.rdbuf();
+    notes = text.str();
+  }
+  if (!notes.empty()) {
+    md << "How to run it and what each figure means: at the end of this page. `-` in a table: no "
+          "data (no finger in contact, no field for a physics method).\n\n";
+  } else {
+    md << "## What is measured\n\n"
+       << "Every mesh is scaled to an 18 cm bounding-box diagonal (hand size). Seeded hand "
+          "placements (`src/placements.h`) put the open palm 1 to 4 cm from a random surface "
+          "point; every method solves the same placements. `solve_us`: per-solve time, minimum "
+          "over repeated batches, SDF build not included (as in the paper's Table 1). "
+          "`sdf_build_ms`: the CPU grab-box SDF build per placement, for the methods that read a "
+          "field. Quality is graded against CGAL's exact distance to the original surface "
+          "(`src/evaluator.h`): `tip_residual_mm` |d(tip) - r_tip| over fingers in contact; "
+          "`penetration_mm` deepest phalanx point inside the mesh per grasp; `early_stops` "
+          "fingers (summed over grasps) that stopped more than 5 mm short of a reachable pose; "
+          "`contacts_mean` fingers within 2 mm per grasp. Any other column is a metric of the "
+          "JSON documented in `src/evaluator.h`. `-`: no data (e.g. no finger in contact, no "
+          "field for a physics method).\n\n";
+  }
 
   // Speed table: the paper's Table 1 layout.
   md << "## Speed\n\nSolve time per grasp, median, microseconds (the paper's Table 1 reports 0.01 "
@@ -908,13 +921,7 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
   }
   md << "The data behind the plots: `bench-data/` (the bench's JSON, one `.dat` per figure and "
         "the gnuplot script `plots.gp`).\n";
-  // Written-by-hand analysis survives regeneration: it lives in its own file, copied in here.
-  const fs::path notes = request.dir / "benchmarks-notes.md";
-  if (std::ifstream notesIn{notes}) {
-    std::stringstream text;
-    text << notesIn.rdbuf();
-    md << "\n<!-- from benchmarks-notes.md -->\n\n" << text.str();
-  }
+  if (!notes.empty()) md << "\n<!-- from benchmarks-notes.md -->\n\n" << notes;
 
   const fs::path mdPath = request.dir / "benchmarks.md";
   if (!writeFile(mdPath, md.str())) {

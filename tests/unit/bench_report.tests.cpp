@@ -36,7 +36,7 @@ TEST_CASE("The report renders every JSON metric, known or not", "[bench][report]
     {"mesh": "cube", "triangles": 12, "method": "paper", "sdf_backend": "cpu", "grasps": 2,
      "sdf_build_ms": {"median": 1.5, "p95": 2}, "solve_us": {"median": 2.25, "p95": 3},
      "tip_residual_mm": {"median": null, "p95": null}, "contact_residual_mm": {"median": 0.125},
-     "pass_through": 3, "note": "text is not a column"},
+     "pass_through": 3, "note": "text is not a column", "contact_fingers": [1, 2, 0, 1, 1]},
     {"mesh": "cube", "triangles": 12, "method": "ours", "sdf_backend": "cpu", "grasps": 2,
      "sdf_build_ms": {"median": 1.5, "p95": 2}, "solve_us": {"median": 40, "p95": 50},
      "tip_residual_mm": {"median": 0.5, "p95": 0.75}, "contact_residual_mm": {"median": 0.0625},
@@ -61,12 +61,13 @@ TEST_CASE("The report renders every JSON metric, known or not", "[bench][report]
     CHECK(md.find("| ours | 40 |") != std::string::npos);
     CHECK(md.find("| CPU SDF build (ms) | 1.5 |") != std::string::npos);
   }
-  SECTION("unknown metrics become columns, missing values a dash, text is left out") {
+  SECTION("unknown metrics become columns, missing values a dash, text and arrays are left out") {
     CHECK(md.find("contact_residual_mm median") != std::string::npos);
     CHECK(md.find("pass_through") != std::string::npos);
     CHECK(md.find("| cube | paper | 2 | - | - | 0.125 | 3 |") != std::string::npos);
     CHECK(md.find("| cube | ours | 2 | 0.5 | 0.75 | 0.0625 | 0 |") != std::string::npos);
     CHECK(md.find("text is not a column") == std::string::npos);
+    CHECK(md.find("contact_fingers") == std::string::npos);  // arrays: not a single figure
   }
   SECTION("the hand-written notes are copied in at the end") {
     CHECK(md.find("## Notes\n\nWritten by hand.\n") != std::string::npos);

@@ -33,6 +33,7 @@
 #include "mesh_distance.h"
 #include "mesh_io.h"
 #include "placements.h"
+#include "report.h"
 #include "sdf_cpu.h"
 #include "sdf_grid.h"
 #include "shapes.h"
@@ -61,6 +62,10 @@ const char* kUsage =
     "  --resolution N     SDF grid nodes per axis, 2..128 (default 16)\n"
     "  --threads N        worker threads for SDF builds and grading (default: all cores)\n"
     "  --json FILE        write the results as JSON\n"
+    "  --report DIR       also write DIR/benchmarks.md with tables and plots (gnuplot) of this\n"
+    "                     run, DIR/img/bench/*.png and DIR/bench-data/; implies --scaling\n"
+    "  --scaling          also time the CPU SDF build against triangles and resolution\n"
+    "  --scaling-quick    --scaling on small spheres only (tests)\n"
     "  --help             this text\n";
 
 struct Options {
@@ -74,6 +79,9 @@ struct Options {
   int resolution = 16;
   unsigned threads = 0;
   std::string json;
+  std::string report;
+  bool scaling = false;
+  bool scalingQuick = false;
 };
 
 struct UsageError {
@@ -176,6 +184,14 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
       if (auto e = needValue(v)) return e;
       if (v.empty()) return UsageError{"--json: empty file name"};
       o.json = v;
+    } else if (arg == "--report") {
+      if (auto e = needValue(v)) return e;
+      if (v.empty()) return UsageError{"--report: empty folder name"};
+      o.report = v;
+      o.scaling = true;
+    } else if (arg == "--scaling" || arg == "--scaling-quick") {
+      o.scaling = true;
+      o.scalingQuick = o.scalingQuick || arg == "--scaling-quick";
     } else {
       return UsageError{"unknown option \"" + std::string(argv[i]) + "\""};
     }
@@ -712,8 +728,14 @@ int main(int argc, char** argv) {
   }
 
   printTables(o, rows);
+  if (!o.report.empty() && o.json.empty()) o.json = bench::reportResultsPath(o.report).string();
   if (!o.json.empty() && !writeJson(o.json, o, rows)) {
     std::fprintf(stderr, "autograsp-bench: cannot write %s\n", o.json.c_str());
+    failed = true;
+  }
+  if (o.scaling && !bench::runReport(bench::ReportRequest{
+                       o.report, o.json, bench::shellCommandLine(argc, argv), threads,
+                       o.scalingQuick, o.resolution, sharedMeshesDir()})) {
     failed = true;
   }
   return failed ? 1 : 0;

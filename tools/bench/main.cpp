@@ -66,6 +66,8 @@ const char* kUsage =
     "                     run, DIR/img/bench/*.png and DIR/bench-data/; implies --scaling\n"
     "  --scaling          also time the CPU SDF build against triangles and resolution\n"
     "  --scaling-quick    --scaling on small spheres only (tests)\n"
+    "  --report-from FILE with --report: write the report from a JSON an earlier run wrote\n"
+    "                     (with --json) instead of running the meshes again\n"
     "  --help             this text\n";
 
 struct Options {
@@ -82,6 +84,7 @@ struct Options {
   std::string report;
   bool scaling = false;
   bool scalingQuick = false;
+  std::string reportFrom;  // a results JSON to report on instead of running
 };
 
 struct UsageError {
@@ -189,6 +192,10 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
       if (v.empty()) return UsageError{"--report: empty folder name"};
       o.report = v;
       o.scaling = true;
+    } else if (arg == "--report-from") {
+      if (auto e = needValue(v)) return e;
+      if (v.empty()) return UsageError{"--report-from: empty file name"};
+      o.reportFrom = v;
     } else if (arg == "--scaling" || arg == "--scaling-quick") {
       o.scaling = true;
       o.scalingQuick = o.scalingQuick || arg == "--scaling-quick";
@@ -197,6 +204,9 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
     }
   }
   if (o.methods.empty()) o.methods = known;
+  if (!o.reportFrom.empty() && o.report.empty()) {
+    return UsageError{"--report-from needs --report DIR"};
+  }
   return std::nullopt;
 }
 
@@ -656,6 +666,14 @@ int main(int argc, char** argv) {
   if (help) {
     std::fputs(kUsage, stdout);
     return 0;
+  }
+  if (!o.reportFrom.empty()) {
+    // A long run's results, reported again (new plots, new notes) without solving again.
+    const bool ok = bench::runReport(bench::ReportRequest{
+        o.report, o.reportFrom, bench::shellCommandLine(argc, argv),
+        o.threads != 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency()),
+        o.scalingQuick, o.resolution, sharedMeshesDir()});
+    return ok ? 0 : 1;
   }
 
   std::vector<MeshSource> sources;

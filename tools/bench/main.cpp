@@ -34,6 +34,7 @@
 #include "mesh_distance.h"
 #include "mesh_io.h"
 #include "placements.h"
+#include "report.h"
 #include "sdf_cpu.h"
 #include "sdf_grid.h"
 #include "shapes.h"
@@ -64,6 +65,12 @@ const char* kUsage =
     "  --thin-plate-set   only the embedded thin plate, graded on the placements where\n"
     "                     \"paper\" (added if missing; --da must be 0.1) passes through it\n"
     "  --json FILE        write the results as JSON\n"
+    "  --report DIR       also write DIR/benchmarks.md with tables and plots (gnuplot) of this\n"
+    "                     run, DIR/img/bench/*.png and DIR/bench-data/; implies --scaling\n"
+    "  --scaling          also time the CPU SDF build against triangles and resolution\n"
+    "  --scaling-quick    --scaling on small spheres only (tests)\n"
+    "  --report-from FILE with --report: write the report from a JSON an earlier run wrote\n"
+    "                     (with --json) instead of running the meshes again\n"
     "  --help             this text\n";
 
 struct Options {
@@ -78,6 +85,10 @@ struct Options {
   int resolution = 16;
   unsigned threads = 0;
   std::string json;
+  std::string report;
+  bool scaling = false;
+  bool scalingQuick = false;
+  std::string reportFrom;  // a results JSON to report on instead of running
 };
 
 struct UsageError {
@@ -182,6 +193,18 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
       if (auto e = needValue(v)) return e;
       if (v.empty()) return UsageError{"--json: empty file name"};
       o.json = v;
+    } else if (arg == "--report") {
+      if (auto e = needValue(v)) return e;
+      if (v.empty()) return UsageError{"--report: empty folder name"};
+      o.report = v;
+      o.scaling = true;
+    } else if (arg == "--report-from") {
+      if (auto e = needValue(v)) return e;
+      if (v.empty()) return UsageError{"--report-from: empty file name"};
+      o.reportFrom = v;
+    } else if (arg == "--scaling" || arg == "--scaling-quick") {
+      o.scaling = true;
+      o.scalingQuick = o.scalingQuick || arg == "--scaling-quick";
     } else {
       return UsageError{"unknown option \"" + std::string(argv[i]) + "\""};
     }
@@ -192,6 +215,9 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
     if (std::find(o.methods.begin(), o.methods.end(), "paper") == o.methods.end()) {
       o.methods.push_back("paper");
     }
+  }
+  if (!o.reportFrom.empty() && o.report.empty()) {
+    return UsageError{"--report-from needs --report DIR"};
   }
   return std::nullopt;
 }
@@ -705,6 +731,14 @@ int main(int argc, char** argv) {
     std::fputs(kUsage, stdout);
     return 0;
   }
+  if (!o.reportFrom.empty()) {
+    // A long run's results, reported again (new plots, new notes) without solving again.
+    const bool ok = bench::runReport(bench::ReportRequest{
+        o.report, o.reportFrom, bench::shellCommandLine(argc, argv),
+        o.threads != 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency()),
+        o.scalingQuick, o.resolution, sharedMeshesDir()});
+    return ok ? 0 : 1;
+  }
 
   std::vector<MeshSource> sources;
   const bool useDefaults = o.meshes.empty() && !o.embeddedOnly && !o.thinPlateSet;
@@ -778,8 +812,14 @@ int main(int argc, char** argv) {
   }
 
   printTables(o, rows);
+  if (!o.report.empty() && o.json.empty()) o.json = bench::reportResultsPath(o.report).string();
   if (!o.json.empty() && !writeJson(o.json, o, rows)) {
     std::fprintf(stderr, "autograsp-bench: cannot write %s\n", o.json.c_str());
+    failed = true;
+  }
+  if (o.scaling && !bench::runReport(bench::ReportRequest{
+                       o.report, o.json, bench::shellCommandLine(argc, argv), threads,
+                       o.scalingQuick, o.resolution, sharedMeshesDir()})) {
     failed = true;
   }
   return failed ? 1 : 0;

@@ -190,6 +190,38 @@ ChainMeasure measureChain(const ExactMeshQuery& mesh, const FingerChain& chain,
   return m;
 }
 
+// Whether some capsule sphere centre of the finger is inside the mesh at any step of the closing
+// sweep (evaluator.h). Distance to the surface is 1-Lipschitz: a centre found outside at distance
+// u cannot reach the inside before it has moved u, and the straight-line distance between sweep
+// samples is at most the sum of the chords, so querying a centre again only once its chord sum
+// exceeds u misses nothing that querying every step would find.
+bool sweepPassesThrough(const ExactMeshQuery& mesh, const HandModel& hand, Finger finger,
+                        const JointCurls& finalCurls, const Pose& objectFromHand,
+                        FingerChain& chain) {
+  float top = 0.0f;
+  for (float c : finalCurls) top = std::max(top, c);
+  const int steps = int(std::ceil(top / kPassThroughSweepStep - 1e-4f));
+  std::vector<glm::vec3> previous;
+  std::vector<double> budget;  // metres each centre may still move unseen
+  for (int k = 0; k <= steps; ++k) {
+    const float s = std::min(top, kPassThroughSweepStep * float(k));
+    JointCurls curls{};
+    for (size_t j = 0; j < curls.size(); ++j) curls[j] = std::min(s, finalCurls[j]);
+    sampleFinger(hand, finger, curls, objectFromHand, chain);
+    if (budget.empty()) budget.assign(chain.points.size(), -1.0);
+    for (size_t i = 0; i < chain.points.size() && i < budget.size(); ++i) {
+      if (!previous.empty()) budget[i] -= double(glm::length(chain.points[i] - previous[i]));
+      if (budget[i] >= 0.0) continue;
+      const double u = mesh.unsignedDistance(chain.points[i]);
+      if (!std::isfinite(u)) return false;
+      if (u > 0.0 && mesh.inside(chain.points[i])) return true;
+      budget[i] = u;
+    }
+    previous = chain.points;
+  }
+  return false;
+}
+
 }  // namespace
 
 GraspMetrics evaluateGrasp(const ExactMeshQuery& mesh, const HandModel& hand,
@@ -201,6 +233,7 @@ GraspMetrics evaluateGrasp(const ExactMeshQuery& mesh, const HandModel& hand,
     const float nan = std::numeric_limits<float>::quiet_NaN();
     for (FingerMetrics& f : out.fingers) {
       f.tipDistanceMm = f.tipGapMm = f.tipResidualMm = f.penetrationMm = f.clearanceMm = nan;
+      f.contactResidualMm = nan;
     }
     out.penetrationMm = nan;
     return out;
@@ -226,6 +259,9 @@ GraspMetrics evaluateGrasp(const ExactMeshQuery& mesh, const HandModel& hand,
     m.penetrationMm = float(at.penetration * 1000.0);
     m.clearanceMm = float(at.clearance * 1000.0);
     m.touching = m.clearanceMm <= kTouchingMm;
+    m.contactResidualMm = std::abs(m.clearanceMm);
+    m.tipIsContact = m.tipGapMm <= m.clearanceMm + kTipContactToleranceMm;
+    m.passThrough = sweepPassesThrough(mesh, hand, finger, stopCurls, objectFromHand, chain);
 
     if (m.stopped && m.tipGapMm > kEarlyStopGapMm) {
       JointCurls curls = stopCurls;
@@ -248,6 +284,7 @@ GraspMetrics evaluateGrasp(const ExactMeshQuery& mesh, const HandModel& hand,
     out.penetrationMm = std::max(out.penetrationMm, m.penetrationMm);
     out.contacts += m.touching ? 1 : 0;
     out.earlyStops += m.earlyStop ? 1 : 0;
+    out.passThroughs += m.passThrough ? 1 : 0;
   }
   return out;
 }

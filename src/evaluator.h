@@ -65,6 +65,11 @@ inline constexpr float kEarlyStopSweepStep = 0.01f;  // curl step of the early-s
 inline constexpr float kSweepPenetrationToleranceMm = 0.1f;
 // Spacing of the spheres that sample each phalanx capsule (radius interpolated between joints).
 inline constexpr float kCapsuleSampleSpacing = 0.002f;  // metres
+// Curl step of the pass-through sweep (every joint from 0 to its final curl).
+inline constexpr float kPassThroughSweepStep = 0.005f;
+// A finger's tip counts as its contact when the tip sphere's gap is within this of the closest
+// phalanx sphere's (the tip is, up to sampling, the closest part of the finger).
+inline constexpr float kTipContactToleranceMm = 0.1f;
 
 struct FingerMetrics {
   bool contact = false;        // the solver said it stopped on the surface (FingerState)
@@ -76,6 +81,14 @@ struct FingerMetrics {
   float clearanceMm = 0.0f;    // min over phalanx spheres of (d - r); <= kTouchingMm: touching
   bool touching = false;
   bool earlyStop = false;  // stopped with a tip gap > 5 mm though a closer pose existed
+  // Contact residual of a whole-finger method: |clearanceMm|, the gap of the closest phalanx
+  // sphere (pad, proximal phalanx or tip). Equals tipResidualMm when the tip is the contact.
+  float contactResidualMm = 0.0f;
+  bool tipIsContact = false;  // tipGapMm <= clearanceMm + kTipContactToleranceMm
+  // Some phalanx capsule sphere was inside the mesh by more than its radius (its centre inside)
+  // at some curl of the sweep from the open hand to the final pose: the finger went through a
+  // part, e.g. skipped a thin plate, even when its final pose is clear.
+  bool passThrough = false;
 };
 
 struct GraspMetrics {
@@ -83,6 +96,7 @@ struct GraspMetrics {
   float penetrationMm = 0.0f;  // max over fingers
   int contacts = 0;            // touching fingers
   int earlyStops = 0;
+  int passThroughs = 0;  // fingers with passThrough
 };
 
 // Metrics of one grasp. `objectFromHand` is the placement the solver saw (non-finite: every
@@ -92,6 +106,12 @@ struct GraspMetrics {
 // every kCapsuleSampleSpacing. Early stop: for a stopped finger with a tip gap > 5 mm, every joint
 // curl is advanced by 0.01 per step (clamped to 1); the finger stopped early if some step brings
 // the tip gap to <= 5 mm before any capsule sphere penetrates by more than 0.1 mm.
+// Pass-through: s runs from 0 to the largest final joint curl in steps of kPassThroughSweepStep
+// (the final curls included); joint j is at min(s, final_j), i.e. all joints close together and
+// each stops at its final curl. At each step every capsule sphere centre is tested for being
+// inside (exact distance, ray parity). A centre found outside at distance u is not tested again
+// until the chord length it has travelled since exceeds u (it cannot have crossed before). Parts
+// thinner than the centres' travel per step (about 1 mm at the tip) can be stepped over unseen.
 GraspMetrics evaluateGrasp(const ExactMeshQuery& mesh, const HandModel& hand,
                            const Pose& objectFromHand, const GraspResult& grasp);
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <glm/geometric.hpp>
+#include <glm/gtx/quaternion.hpp>
 
 #include "evaluator.h"
 #include "hand_model.h"
@@ -171,6 +172,58 @@ TEST_CASE("Grasp metrics report penetration, residual and early stops", "[core][
     CHECK(f.touching);
     CHECK_FALSE(f.earlyStop);
     CHECK(m.contacts >= 1);
+    // The tip is the contact: both residuals agree.
+    CHECK(f.tipIsContact);
+    CHECK(f.contactResidualMm == Approx(gap * 1000.0f).margin(0.1));
+    CHECK_FALSE(f.passThrough);
+  }
+  SECTION("A finger touching with its middle phalanx has that gap as contact residual") {
+    // Straight finger (curl 0); a sphere just under the intermediate joint, on the side the
+    // finger closes towards, at a known gap from that joint's sphere.
+    const float gap = 0.001f, radius = 0.01f;
+    const std::span<const Joint> joints = fingerJoints(index);
+    std::vector<Pose> poses(joints.size());
+    hand.fingerPose(index, 0.0f, poses);
+    const glm::vec3 joint = poses[2].position;
+    const float r = hand.jointRadius(joints[2]);
+    const glm::vec3 bone = glm::normalize(poses[3].position - poses[2].position);
+    glm::vec3 closing = hand.tipPosition(index, 0.2f) - hand.tipPosition(index, 0.0f);
+    closing = glm::normalize(closing - bone * glm::dot(closing, bone));
+    auto q = queryOf(sphereAt(joint + closing * (r + gap + radius), radius));
+    GraspResult g = allAt(0.0f);
+    g.fingers[int(index)].contact = true;
+    const GraspMetrics m = evaluateGrasp(*q, hand, identity, g);
+    const FingerMetrics& f = m.fingers[int(index)];
+    CHECK(f.clearanceMm == Approx(gap * 1000.0f).margin(0.15));
+    CHECK(f.contactResidualMm == Approx(gap * 1000.0f).margin(0.15));
+    CHECK_FALSE(f.tipIsContact);
+    CHECK(f.tipResidualMm > f.contactResidualMm + 2.0f);
+    CHECK(f.penetrationMm == 0.0f);
+    CHECK_FALSE(f.passThrough);
+  }
+  SECTION("A finger whose sweep crosses a thin plate passes through; one stopped short does not") {
+    // A 3 mm plate across the index tip's path at curl 0.5, square to the tip's motion there.
+    const glm::vec3 at = hand.tipPosition(index, 0.5f);
+    const glm::vec3 motion =
+        glm::normalize(hand.tipPosition(index, 0.52f) - hand.tipPosition(index, 0.48f));
+    TriangleMesh plate = makeBox(glm::vec3(0.02f, 0.003f, 0.02f));
+    transformMesh(plate, Pose{glm::rotation(glm::vec3(0.0f, 1.0f, 0.0f), motion), at});
+    auto q = queryOf(plate);
+    // Precondition: the tip centre is inside the plate at curl 0.5 and outside at both ends.
+    REQUIRE(q->inside(at));
+    REQUIRE_FALSE(q->inside(hand.tipPosition(index, 1.0f)));
+    REQUIRE(q->signedDistance(hand.tipPosition(index, 0.3f)) > rTip);
+
+    GraspResult through = allAt(0.0f);
+    through.fingers[int(index)] = allAt(1.0f).fingers[int(index)];
+    const GraspMetrics m = evaluateGrasp(*q, hand, identity, through);
+    CHECK(m.fingers[int(index)].passThrough);
+    CHECK(m.passThroughs >= 1);
+
+    GraspResult shortOf = allAt(0.0f);
+    shortOf.fingers[int(index)] = allAt(0.3f).fingers[int(index)];
+    const GraspMetrics s = evaluateGrasp(*q, hand, identity, shortOf);
+    CHECK_FALSE(s.fingers[int(index)].passThrough);
   }
   SECTION("A finger left open above a plane it could reach is an early stop") {
     const float reach = 0.5f;

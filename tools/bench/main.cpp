@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -61,6 +62,8 @@ const char* kUsage =
     "  --da X             curl step of the solvers, in (0, 1] (default 0.1)\n"
     "  --resolution N     SDF grid nodes per axis, 2..128 (default 16)\n"
     "  --threads N        worker threads for SDF builds and grading (default: all cores)\n"
+    "  --thin-plate-set   only the embedded thin plate, graded on the placements where\n"
+    "                     \"paper\" (added if missing; --da must be 0.1) passes through it\n"
     "  --json FILE        write the results as JSON\n"
     "  --report DIR       also write DIR/benchmarks.md with tables and plots (gnuplot) of this\n"
     "                     run, DIR/img/bench/*.png and DIR/bench-data/; implies --scaling\n"
@@ -74,6 +77,7 @@ struct Options {
   std::vector<std::string> meshes;
   bool embedded = false;
   bool embeddedOnly = false;
+  bool thinPlateSet = false;
   int placements = 1000;
   uint64_t seed = 1;
   std::vector<std::string> methods;
@@ -131,6 +135,8 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
       o.embedded = true;
     } else if (arg == "--embedded-only") {
       o.embeddedOnly = true;
+    } else if (arg == "--thin-plate-set") {
+      o.thinPlateSet = true;
     } else if (arg == "--mesh") {
       if (auto e = needValue(v)) return e;
       o.meshes.push_back(v);
@@ -204,6 +210,12 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
     }
   }
   if (o.methods.empty()) o.methods = known;
+  if (o.thinPlateSet) {
+    if (o.da != 0.1f) return UsageError{"--thin-plate-set: the set is defined at --da 0.1"};
+    if (std::find(o.methods.begin(), o.methods.end(), "paper") == o.methods.end()) {
+      o.methods.push_back("paper");
+    }
+  }
   if (!o.reportFrom.empty() && o.report.empty()) {
     return UsageError{"--report-from needs --report DIR"};
   }
@@ -231,8 +243,12 @@ struct Row {
   int failedSolves = 0;
   std::vector<double> sdfBuildMs;
   std::vector<double> solveUs;
-  std::vector<double> tipResidualMm;  // per finger in contact
-  std::vector<double> penetrationMm;  // per grasp: deepest phalanx point
+  std::vector<double> tipResidualMm;      // per finger in contact
+  std::vector<double> contactResidualMm;  // per finger in contact: closest phalanx sphere's gap
+  std::array<long long, kFingerCount> contactFingers{};     // fingers in contact, per finger
+  std::array<long long, kFingerCount> tipContactFingers{};  // ... whose tip is the contact
+  long long passThroughs = 0;                               // fingers whose sweep went through
+  std::vector<double> penetrationMm;                        // per grasp: deepest phalanx point
   int earlyStops = 0;
   long long contacts = 0;
 
@@ -466,17 +482,38 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
   phaseSeconds.solve = std::chrono::duration<double>(solvedAt - startedAt).count();
   phaseSeconds.grade = std::chrono::duration<double>(now() - solvedAt).count();
 
+  // The thin-plate set: only the placements where "paper" went through the plate.
+  std::vector<char> selected(placements.size(), 1);
+  if (o.thinPlateSet) {
+    size_t paper = 0;
+    while (paper < methods.size() && methods[paper].name != "paper") ++paper;
+    size_t count = 0;
+    for (size_t p = 0; p < placements.size(); ++p) {
+      selected[p] = paper < methods.size() && solved[paper][p] &&
+                    metrics[paper * placements.size() + p].passThroughs > 0;
+      count += selected[p] ? 1 : 0;
+    }
+    std::fprintf(stderr, "%s: %zu of %zu placements where paper passes through\n", name.c_str(),
+                 count, placements.size());
+    for (Row& row : rows) row.mesh = name + "/paper-skips";
+  }
   for (size_t m = 0; m < methods.size(); ++m) {
     Row& row = rows[m];
     for (size_t p = 0; p < placements.size(); ++p) {
-      if (!solved[m][p]) continue;
+      if (!solved[m][p] || !selected[p]) continue;
       const GraspMetrics& g = metrics[m * placements.size() + p];
       row.grasps++;
       row.penetrationMm.push_back(g.penetrationMm);
       row.earlyStops += g.earlyStops;
       row.contacts += g.contacts;
-      for (const FingerMetrics& f : g.fingers) {
-        if (f.contact) row.tipResidualMm.push_back(f.tipResidualMm);
+      row.passThroughs += g.passThroughs;
+      for (int f = 0; f < kFingerCount; ++f) {
+        const FingerMetrics& fm = g.fingers[f];
+        if (!fm.contact) continue;
+        row.tipResidualMm.push_back(fm.tipResidualMm);
+        row.contactResidualMm.push_back(fm.contactResidualMm);
+        row.contactFingers[f]++;
+        row.tipContactFingers[f] += fm.tipIsContact ? 1 : 0;
       }
     }
   }
@@ -528,10 +565,18 @@ std::string jsonNumber(double v) {
   return buf;
 }
 
+// Per-finger counts, thumb to little.
+std::string jsonCounts(const std::array<long long, kFingerCount>& counts) {
+  std::string out = "[";
+  for (int f = 0; f < kFingerCount; ++f) out += (f ? ", " : "") + std::to_string(counts[f]);
+  return out + "]";
+}
+
 bool writeJson(const std::string& file, const Options& o, const std::vector<Row>& rows) {
   std::ofstream out(file);
   if (!out) return false;
-  out << "{\n  \"placements\": " << o.placements << ",\n  \"seed\": " << o.seed
+  out << "{\n  \"placements\": " << o.placements << ",\n  \"da\": " << jsonNumber(o.da)
+      << ",\n  \"resolution\": " << o.resolution << ",\n  \"seed\": " << o.seed
       << ",\n  \"rows\": [";
   for (size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
@@ -549,7 +594,13 @@ bool writeJson(const std::string& file, const Options& o, const std::vector<Row>
         << ",\n     \"tip_residual_mm\": {\"median\": "
         << jsonNumber(percentile(r.tipResidualMm, 0.5))
         << ", \"p95\": " << jsonNumber(percentile(r.tipResidualMm, 0.95)) << "}"
-        << ", \"penetration_mm\": {\"p99\": " << jsonNumber(percentile(r.penetrationMm, 0.99))
+        << ", \"contact_residual_mm\": {\"median\": "
+        << jsonNumber(percentile(r.contactResidualMm, 0.5))
+        << ", \"p95\": " << jsonNumber(percentile(r.contactResidualMm, 0.95)) << "}"
+        << ",\n     \"contact_fingers\": " << jsonCounts(r.contactFingers)
+        << ", \"tip_contact_fingers\": " << jsonCounts(r.tipContactFingers)
+        << ", \"pass_through\": " << r.passThroughs
+        << ",\n     \"penetration_mm\": {\"p99\": " << jsonNumber(percentile(r.penetrationMm, 0.99))
         << ", \"max\": " << jsonNumber(percentile(r.penetrationMm, 1.0)) << "}"
         << ", \"early_stops\": " << r.earlyStops
         << ", \"contacts_mean\": " << jsonNumber(r.contactsMean()) << "}";
@@ -615,23 +666,36 @@ void printTables(const Options& o, const std::vector<Row>& rows) {
   std::printf(
       "\n\nQuality against the exact mesh (tip residual over fingers in contact; "
       "penetration over grasps)\n");
-  std::printf("%-24s %-16s %6s %9s %9s %9s %9s %7s %8s\n", "mesh", "method", "grasps", "tip_med",
-              "tip_p95", "pen_p99", "pen_max", "early", "contacts");
+  std::printf("%-24s %-16s %6s %9s %9s %9s %9s %9s %9s %7s %8s %6s %5s\n", "mesh", "method",
+              "grasps", "tip_med", "tip_p95", "cres_med", "cres_p95", "pen_p99", "pen_max", "early",
+              "contacts", "tip%", "pass");
   for (const auto& m : meshes) {
     for (const auto& method : o.methods) {
       const Row* r = find(m, method);
       if (!r) continue;
-      std::printf("%-24s %-16s %6d %9s %9s %9s %9s %7d %8s\n", m.c_str(), method.c_str(), r->grasps,
-                  fmt(percentile(r->tipResidualMm, 0.5)).c_str(),
-                  fmt(percentile(r->tipResidualMm, 0.95)).c_str(),
-                  fmt(percentile(r->penetrationMm, 0.99)).c_str(),
-                  fmt(percentile(r->penetrationMm, 1.0)).c_str(), r->earlyStops,
-                  fmt(r->contactsMean()).c_str());
+      long long inContact = 0, tipContact = 0;
+      for (int f = 0; f < kFingerCount; ++f) {
+        inContact += r->contactFingers[f];
+        tipContact += r->tipContactFingers[f];
+      }
+      std::printf(
+          "%-24s %-16s %6d %9s %9s %9s %9s %9s %9s %7d %8s %6s %5lld\n", m.c_str(), method.c_str(),
+          r->grasps, fmt(percentile(r->tipResidualMm, 0.5)).c_str(),
+          fmt(percentile(r->tipResidualMm, 0.95)).c_str(),
+          fmt(percentile(r->contactResidualMm, 0.5)).c_str(),
+          fmt(percentile(r->contactResidualMm, 0.95)).c_str(),
+          fmt(percentile(r->penetrationMm, 0.99)).c_str(),
+          fmt(percentile(r->penetrationMm, 1.0)).c_str(), r->earlyStops,
+          fmt(r->contactsMean()).c_str(),
+          inContact > 0 ? fmt(100.0 * double(tipContact) / double(inContact), "%.0f").c_str() : "-",
+          r->passThroughs);
     }
   }
   std::printf(
-      "(mm; early = fingers stopped > 5 mm short of a reachable pose; contacts = fingers "
-      "within 2 mm, mean per grasp)\n");
+      "(mm; tip = |tip gap| and cres = |closest phalanx sphere gap|, over fingers in contact; "
+      "early = fingers stopped > 5 mm short of a reachable pose; contacts = fingers within 2 mm, "
+      "mean per grasp; tip%% = fingers in contact whose tip is the closest sphere; pass = fingers "
+      "whose closing sweep put a sphere centre inside the mesh)\n");
 
   const std::string base = "paper";
   if (std::find(o.methods.begin(), o.methods.end(), base) == o.methods.end()) return;
@@ -677,12 +741,14 @@ int main(int argc, char** argv) {
   }
 
   std::vector<MeshSource> sources;
-  const bool useDefaults = o.meshes.empty() && !o.embeddedOnly;
-  if (o.embeddedOnly || o.embedded || useDefaults) {
-    for (NamedMesh& m : embeddedObjects())
+  const bool useDefaults = o.meshes.empty() && !o.embeddedOnly && !o.thinPlateSet;
+  if (o.embeddedOnly || o.embedded || useDefaults || o.thinPlateSet) {
+    for (NamedMesh& m : embeddedObjects()) {
+      if (o.thinPlateSet && m.name != "thin-plate") continue;
       sources.push_back({m.name, std::nullopt, std::move(m.mesh)});
+    }
   }
-  if (!o.embeddedOnly) {
+  if (!o.embeddedOnly && !o.thinPlateSet) {
     std::vector<fs::path> files(o.meshes.begin(), o.meshes.end());
     if (useDefaults) {
       if (auto dir = sharedMeshesDir()) {

@@ -1,0 +1,57 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Pass 4, one invocation per node, once per jump step: jump flooding (Rong & Tan 2006) of
+// closest-triangle ids. A node looks at the 26 nodes `step` away and keeps, of its own and
+// their triangles, the one at the smallest exact distance from itself. Distances are always
+// exact point-triangle distances, so a propagated id can only make a node's value larger than
+// the true distance when the flood missed the true closest triangle.
+#include "sdf_common.glsl"
+
+// Bindings 6 and 7: ping-pong id buffers; pc.flip picks the direction.
+layout(std430, set = 0, binding = 6) buffer IdsA { uint idsA[]; };
+layout(std430, set = 0, binding = 7) buffer IdsB { uint idsB[]; };
+
+layout(push_constant) uniform Push { uint step; uint flip; } pc;
+
+uint readId(uint v) { return pc.flip == 0u ? idsA[v] : idsB[v]; }
+
+void main() {
+  uint v = gl_GlobalInvocationID.x;
+  if (v >= P.res.w) return;  // the dispatch is rounded up to whole groups
+  uvec3 ijk = nodeCoords(v);
+  vec3 p = nodePosition(ijk);
+  uint best = readId(v);
+  float bestD = best == kNoTriangle ? 3.4e38 : triangleDistance(p, best);
+  // Within one spacing the splat already found the exact closest triangle (every triangle that
+  // close covered this node); nothing can beat it.
+  float exactBand = min(P.spacing.x, min(P.spacing.y, P.spacing.z));
+  if (bestD > exactBand) {
+    ivec3 base = ivec3(ijk);
+    ivec3 n = ivec3(P.res.xyz);
+    int s = int(pc.step);
+    uint last = best;  // neighbours often share one id: evaluate a repeat only once
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          ivec3 q = base + ivec3(dx, dy, dz) * s;
+          if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, n))) continue;
+          uint cand = readId(uint(q.x) + P.res.x * (uint(q.y) + P.res.y * uint(q.z)));
+          if (cand == kNoTriangle || cand == best || cand == last) continue;
+          last = cand;
+          // Lower bound from the sphere about corner a through the farther corner: a
+          // candidate that cannot beat the best skips the exact distance.
+          vec3 a = tri[3u * cand].xyz;
+          float reach = sqrt(max(dot(tri[3u * cand + 1u].xyz - a, tri[3u * cand + 1u].xyz - a),
+                                 dot(tri[3u * cand + 2u].xyz - a, tri[3u * cand + 2u].xyz - a)));
+          if (length(p - a) - reach >= bestD) continue;
+          float d = triangleDistance(p, cand);
+          if (d < bestD) {
+            bestD = d;
+            best = cand;
+          }
+        }
+      }
+    }
+  }
+  if (pc.flip == 0u) idsB[v] = best; else idsA[v] = best;
+}

@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# The README's main command: installs what is missing, builds, and runs the main job on embedded
-# defaults. Until the headless demo exists this is the benchmark on the embedded objects.
-# Extra arguments go to autograsp-bench.
+# The README's main command: installs what is missing, builds, and runs the headless demo
+# (autograsp-demo) on the embedded objects (mug, torus, thin plate): an OpenXR app through the
+# real loader, the mock runtime and the layer, rendered with Vulkan (lavapipe without a GPU).
+# It writes PNG pictures and out/demo/report.html.
+# Extra arguments go to autograsp-demo (see --help), e.g. --mesh my.obj or --width 1024.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$root/scripts/build.sh" default
-mkdir -p "$root/out"
-"$root/build/default/tools/bench/autograsp-bench" --embedded-only --placements 200 \
-  --json "$root/out/bench.json" "$@"
+"$root/build/default/tools/demo/autograsp-demo" --embedded-only --out "$root/out/demo" "$@"

@@ -11,14 +11,14 @@ namespace sdfg {
 std::optional<Error> validateMesh(std::span<const glm::vec3> positions,
                                   std::span<const uint32_t> indices) {
   if (positions.empty() || indices.empty()) {
-    return makeError(Status::invalid_argument,
-                     "mesh: empty (" + std::to_string(positions.size()) + " vertices, " +
-                         std::to_string(indices.size()) + " indices)");
+    return makeError(Status::invalid_argument, "mesh: empty (" + std::to_string(positions.size()) +
+                                                   " vertices, " + std::to_string(indices.size()) +
+                                                   " indices)");
   }
   if (indices.size() % 3 != 0) {
-    return makeError(Status::invalid_argument,
-                     "mesh: index count " + std::to_string(indices.size()) +
-                         " is not a multiple of 3");
+    return makeError(
+        Status::invalid_argument,
+        "mesh: index count " + std::to_string(indices.size()) + " is not a multiple of 3");
   }
   for (size_t v = 0; v < positions.size(); ++v) {
     const glm::vec3& p = positions[v];
@@ -30,19 +30,18 @@ std::optional<Error> validateMesh(std::span<const glm::vec3> positions,
   for (size_t i = 0; i < indices.size(); ++i) {
     if (indices[i] >= positions.size()) {
       return makeError(Status::invalid_argument,
-                       "mesh: index " + std::to_string(i) + " (triangle " +
-                           std::to_string(i / 3) + ") is " + std::to_string(indices[i]) +
-                           ", but the mesh has " + std::to_string(positions.size()) +
-                           " vertices");
+                       "mesh: index " + std::to_string(i) + " (triangle " + std::to_string(i / 3) +
+                           ") is " + std::to_string(indices[i]) + ", but the mesh has " +
+                           std::to_string(positions.size()) + " vertices");
     }
   }
   for (size_t t = 0; t < indices.size() / 3; ++t) {
     const uint32_t a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
     if (a == b || b == c || a == c) {
-      return makeError(Status::invalid_argument,
-                       "mesh: triangle " + std::to_string(t) + " repeats a vertex (" +
-                           std::to_string(a) + ", " + std::to_string(b) + ", " +
-                           std::to_string(c) + ")");
+      return makeError(Status::invalid_argument, "mesh: triangle " + std::to_string(t) +
+                                                     " repeats a vertex (" + std::to_string(a) +
+                                                     ", " + std::to_string(b) + ", " +
+                                                     std::to_string(c) + ")");
     }
     // Zero area in double precision: the three corners are collinear (or coincide).
     const glm::dvec3 pa(positions[a]), pb(positions[b]), pc(positions[c]);
@@ -66,9 +65,9 @@ Result<TriangleMesh> makeMesh(std::span<const glm::vec3> positions,
 
 Result<TriangleMesh> makeMesh(std::span<const float> xyz, std::span<const uint32_t> indices) {
   if (xyz.size() % 3 != 0) {
-    return makeError(Status::invalid_argument,
-                     "mesh: position array has " + std::to_string(xyz.size()) +
-                         " floats, not a multiple of 3");
+    return makeError(
+        Status::invalid_argument,
+        "mesh: position array has " + std::to_string(xyz.size()) + " floats, not a multiple of 3");
   }
   std::vector<glm::vec3> positions(xyz.size() / 3);
   for (size_t v = 0; v < positions.size(); ++v) {

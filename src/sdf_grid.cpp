@@ -18,16 +18,16 @@ GridBox GridBox::referenceDefault() {
 std::optional<Error> GridBox::validate() const {
   for (int a = 0; a < 3; ++a) {
     if (!std::isfinite(size[a]) || size[a] <= 0.0f) {
-      return makeError(Status::invalid_argument,
-                       "grid box: size[" + std::to_string(a) + "] = " + std::to_string(size[a]) +
-                           " must be finite and positive");
+      return makeError(Status::invalid_argument, "grid box: size[" + std::to_string(a) +
+                                                     "] = " + std::to_string(size[a]) +
+                                                     " must be finite and positive");
     }
     if (resolution[a] < kMinGridResolution || resolution[a] > kMaxGridResolution) {
-      return makeError(Status::invalid_argument,
-                       "grid box: resolution[" + std::to_string(a) + "] = " +
-                           std::to_string(resolution[a]) + " is outside [" +
-                           std::to_string(kMinGridResolution) + ", " +
-                           std::to_string(kMaxGridResolution) + "]");
+      return makeError(Status::invalid_argument, "grid box: resolution[" + std::to_string(a) +
+                                                     "] = " + std::to_string(resolution[a]) +
+                                                     " is outside [" +
+                                                     std::to_string(kMinGridResolution) + ", " +
+                                                     std::to_string(kMaxGridResolution) + "]");
     }
   }
   const glm::quat& q = handFromBox.orientation;

@@ -22,9 +22,9 @@ inline constexpr uint32_t kMinGridResolution = 2;
 inline constexpr uint32_t kMaxGridResolution = 128;
 
 struct GridBox {
-  Pose handFromBox;                           // box centre and axes in hand space
-  glm::vec3 size{0.2133f};                    // edge lengths, metres
-  glm::uvec3 resolution{16u, 16u, 16u};       // nodes per axis, each in [2, 128]
+  Pose handFromBox;                      // box centre and axes in hand space
+  glm::vec3 size{0.2133f};               // edge lengths, metres
+  glm::uvec3 resolution{16u, 16u, 16u};  // nodes per axis, each in [2, 128]
 
   // The paper's reference box: a 0.2133 m cube centred 8.1 cm in front of and 7.5 cm below
   // (toward the palm) the wrist joint, 16 nodes per axis.
@@ -65,7 +65,9 @@ class SdfGrid {
   // Trilinear value at normalized box coordinates (clamped to [0,1]^3).
   float sampleNormalized(const glm::vec3& uvw) const;
   // Trilinear value at a hand-space point.
-  float sample(const glm::vec3& pHand) const { return sampleNormalized(box_.handToNormalized(pHand)); }
+  float sample(const glm::vec3& pHand) const {
+    return sampleNormalized(box_.handToNormalized(pHand));
+  }
   // Gradient of the trilinear interpolant at a hand-space point, in hand space (per metre).
   glm::vec3 gradient(const glm::vec3& pHand) const;
 

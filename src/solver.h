@@ -27,21 +27,27 @@ namespace sdfg {
 class PhysicsCollider;  // solver_physics.h
 
 struct SolverOptions {
-  float da = 0.1f;              // curl step along each finger's curve, in (0, 1]
-  float threshold = -1.0f;      // stop distance in metres; < 0: each finger's tip radius
-  float refineStep = 0.01f;     // physics strategies: the fine step after the coarse one
+  float da = 0.1f;           // curl step along each finger's curve, in (0, 1]
+  float threshold = -1.0f;   // stop distance in metres; < 0: each finger's tip radius
+  float refineStep = 0.01f;  // physics strategies: the fine step after the coarse one
+  bool approach = false;     // "ours": move the hand onto the surface first (approachPose)
 };
 
 struct FingerState {
-  float curl = 0.0f;             // overall curl of the finger (its tip's curve parameter)
-  JointCurls jointCurls{};       // per joint; all equal to `curl` for single-curl strategies
-  bool contact = false;          // stopped on the surface (false: closed fully without touching)
-  glm::vec3 contactPoint{0.0f};  // hand space: where the finger touches (the stopping sphere's centre)
-  float distance = 0.0f;         // the target's distance at contactPoint as the strategy saw it
+  float curl = 0.0f;        // overall curl of the finger (its tip's curve parameter)
+  JointCurls jointCurls{};  // per joint; all equal to `curl` for single-curl strategies
+  bool contact = false;     // stopped on the surface (false: closed fully without touching)
+  glm::vec3 contactPoint{
+      0.0f};              // hand space: where the finger touches (the stopping sphere's centre)
+  float distance = 0.0f;  // the target's distance at contactPoint as the strategy saw it
 };
 
 struct GraspResult {
   std::array<FingerState, kFingerCount> fingers{};
+  // Where the strategy moved the hand before closing it (SolverOptions::approach): maps the
+  // corrected hand frame, in which the fingers and contact points are, into the scene's hand
+  // frame. Identity for every strategy that leaves the hand where it is.
+  Pose handCorrection{};
 };
 
 // The target as the solvers see it. Only the representation a strategy asks for must be set.

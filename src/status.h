@@ -34,8 +34,8 @@ struct Error {
 template <class T>
 class Result {
  public:
-  Result(T value) : state_(std::move(value)) {}        // NOLINT: implicit by design
-  Result(Error error) : state_(std::move(error)) {}    // NOLINT: implicit by design
+  Result(T value) : state_(std::move(value)) {}      // NOLINT: implicit by design
+  Result(Error error) : state_(std::move(error)) {}  // NOLINT: implicit by design
 
   bool ok() const { return std::holds_alternative<T>(state_); }
   explicit operator bool() const { return ok(); }
@@ -54,6 +54,8 @@ class Result {
   std::variant<T, Error> state_;
 };
 
-inline Error makeError(Status code, std::string message) { return Error{code, std::move(message)}; }
+inline Error makeError(Status code, std::string message) {
+  return Error{code, std::move(message)};
+}
 
 }  // namespace sdfg

@@ -126,6 +126,7 @@ TEST_CASE("Closest points match brute force on the shared test meshes", "[mesh_d
   const char* names[] = {"stanford-bunny.obj",
                          "stanford-armadillo-100k.obj",
                          "stanford-dragon-100k.obj",
+                         "stanford-dragon-100k.ply",
                          "igea-268k.obj",
                          "torus.obj",
                          "newell-teapot.obj",

@@ -8,10 +8,11 @@
 TEST_CASE("every listed solver name creates a solver of that name", "[solver]") {
   using namespace sdfg;
   const std::vector<std::string> names = solverNames();
-  REQUIRE(names.size() >= 3);
-  CHECK(names[0] == "paper");
-  CHECK(names[1] == "physics-convex");
-  CHECK(names[2] == "physics-mesh");
+  REQUIRE(names.size() >= 4);
+  CHECK(names[0] == "ours");  // the default
+  CHECK(names[1] == "paper");
+  CHECK(names[2] == "physics-convex");
+  CHECK(names[3] == "physics-mesh");
   for (const std::string& name : names) {
     CAPTURE(name);
     auto solver = createSolver(name);

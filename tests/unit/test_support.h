@@ -19,8 +19,8 @@ std::optional<std::filesystem::path> sharedMesh(const std::string& fileName);
 
 // Ends the current test case as skipped: ctest matches the marker (SKIP_REGULAR_EXPRESSION) and
 // reports the test as skipped, never as passed. Catch2 2.x has no SKIP of its own.
-#define SDFG_SKIP(reason)                                        \
-  do {                                                           \
-    std::cout << "SDFG_SKIPPED: " << (reason) << std::endl;      \
-    return;                                                      \
+#define SDFG_SKIP(reason)                                   \
+  do {                                                      \
+    std::cout << "SDFG_SKIPPED: " << (reason) << std::endl; \
+    return;                                                 \
   } while (false)

@@ -1,0 +1,107 @@
+#include "config.h"
+
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+
+namespace sdfg::layer {
+namespace {
+
+std::string trim(const std::string& s) {
+  size_t a = 0, b = s.size();
+  while (a < b && std::isspace(static_cast<unsigned char>(s[a]))) ++a;
+  while (b > a && std::isspace(static_cast<unsigned char>(s[b - 1]))) --b;
+  return s.substr(a, b - a);
+}
+
+bool parseFloat(const std::string& text, float lo, float hi, float& out) {
+  char* end = nullptr;
+  const float v = std::strtof(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || v < lo || v > hi) return false;
+  out = v;
+  return true;
+}
+
+bool parseBool(const std::string& text, bool& out) {
+  if (text == "1" || text == "true" || text == "on" || text == "yes") return out = true, true;
+  if (text == "0" || text == "false" || text == "off" || text == "no") return out = false, true;
+  return false;
+}
+
+const char* const kKeys[] = {"log_level",  "solver",    "grab_threshold", "release_ratio",
+                             "resolution", "curl_step", "synthesis",      "gpu"};
+
+}  // namespace
+
+bool applyConfigValue(Config& config, const std::string& key, const std::string& value) {
+  Config c = config;
+  bool ok = true;
+  if (key == "log_level") {
+    c.logLevel = parseLogLevel(value.c_str(), LogLevel(-1));
+    ok = c.logLevel != LogLevel(-1);
+  } else if (key == "solver") {
+    ok = !value.empty() && value.size() < 64;
+    c.solver = value;
+  } else if (key == "grab_threshold") {
+    ok = parseFloat(value, 0.01f, 1.0f, c.grabThreshold);
+  } else if (key == "release_ratio") {
+    ok = parseFloat(value, 0.0f, 1.0f, c.releaseRatio);
+  } else if (key == "resolution") {
+    float r = 0;
+    ok = parseFloat(value, 2, 128, r) && r == std::floor(r);
+    c.resolution = unsigned(r);
+  } else if (key == "curl_step") {
+    ok = parseFloat(value, 1e-5f, 1.0f, c.curlStep);
+  } else if (key == "synthesis") {
+    ok = parseBool(value, c.synthesis);
+  } else if (key == "gpu") {
+    ok = parseBool(value, c.gpu);
+  } else {
+    ok = false;
+  }
+  if (ok) config = c;
+  return ok;
+}
+
+Config loadConfig() {
+  Config config;
+  std::string dir;
+  if (const char* xdg = std::getenv("XDG_CONFIG_HOME"); xdg != nullptr && xdg[0] == '/')
+    dir = xdg;
+  else if (const char* home = std::getenv("HOME"); home != nullptr && home[0] != '\0')
+    dir = std::string(home) + "/.config";
+  if (!dir.empty()) {
+    const std::string path = dir + "/sdfg-autograsp/config";
+    std::ifstream file(path);
+    if (file) {
+      config.configPath = path;
+      std::string line;
+      int number = 0;
+      while (std::getline(file, line)) {
+        ++number;
+        if (const size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+        line = trim(line);
+        if (line.empty()) continue;
+        const size_t eq = line.find('=');
+        const std::string key = eq == std::string::npos ? line : trim(line.substr(0, eq));
+        const std::string value = eq == std::string::npos ? "" : trim(line.substr(eq + 1));
+        if (!applyConfigValue(config, key, value))
+          SDFG_LOG_WARN("config", "%s:%d: ignored '%s = %s' (unknown key or bad value)",
+                        path.c_str(), number, key.c_str(), value.c_str());
+      }
+    }
+  }
+  for (const char* key : kKeys) {
+    std::string name = "SDFG_AUTOGRASP_";
+    for (const char* p = key; *p != '\0'; ++p)
+      name += char(std::toupper(static_cast<unsigned char>(*p)));
+    if (const char* value = std::getenv(name.c_str()); value != nullptr) {
+      if (!applyConfigValue(config, key, value))
+        SDFG_LOG_WARN("config", "ignored %s=%s (bad value)", name.c_str(), value);
+    }
+  }
+  return config;
+}
+
+}  // namespace sdfg::layer

@@ -1,0 +1,31 @@
+// Configuration of the layer, read once per instance: built-in defaults, then the file
+// $XDG_CONFIG_HOME/sdfg-autograsp/config (default ~/.config/sdfg-autograsp/config; lines
+// "key = value", '#' comments), then environment variables SDFG_AUTOGRASP_<KEY> (key in upper
+// case), which win. Keys and meanings: docs/layer.md. Bad values are logged and ignored.
+#pragma once
+
+#include <string>
+
+#include "log.h"
+
+namespace sdfg::layer {
+
+struct Config {
+  LogLevel logLevel = LogLevel::warn;  // log_level
+  std::string solver = "default";      // solver: default, paper, ours, or a core strategy name
+  float grabThreshold = 0.7f;          // grab_threshold: squeeze that starts a grab
+  float releaseRatio = 0.8f;           // release_ratio: a grab ends below threshold * ratio
+  unsigned resolution = 16;            // resolution: grid nodes per axis, 2..128
+  float curlStep = 0.02f;              // curl_step: solver step along each finger curve
+  bool synthesis = true;               // synthesis: offer XR_EXT_hand_tracking from controllers
+  bool gpu = true;                     // gpu: build SDFs on the app's Vulkan device when possible
+  std::string configPath;              // the file that was read, empty when none
+};
+
+Config loadConfig();
+
+// Applies one "key = value" pair; returns false (and leaves `config` unchanged) when the key is
+// unknown or the value is out of range.
+bool applyConfigValue(Config& config, const std::string& key, const std::string& value);
+
+}  // namespace sdfg::layer

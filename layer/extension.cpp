@@ -1,0 +1,277 @@
+// XR_SDFG_auto_grasp entry points. Each: resolve and check the handle, one check per argument,
+// one call into the core, one conversion of the result. A failing call changes nothing.
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "intercepts.h"
+#include "log.h"
+#include "state.h"
+
+namespace sdfg::layer {
+namespace {
+
+#define SDFG_VERIFY(cmd, cond, result, ...) \
+  if (!(cond)) return logError(result, cmd, __VA_ARGS__)
+#define SDFG_VERIFY_NOT_NULL(cmd, arg) \
+  SDFG_VERIFY(cmd, (arg) != nullptr, XR_ERROR_VALIDATION_FAILURE, "(" #arg ") is null")
+#define SDFG_VERIFY_TYPE(cmd, arg, expected)                               \
+  SDFG_VERIFY_NOT_NULL(cmd, arg);                                          \
+  SDFG_VERIFY(cmd, (arg)->type == (expected), XR_ERROR_VALIDATION_FAILURE, \
+              "(" #arg "->type) is %d, expected " #expected, int((arg)->type))
+
+std::shared_ptr<SessionState> findSession(XrSession session) {
+  return sessions().find(key(session));
+}
+
+// The target and its live session, or nulls.
+std::pair<std::shared_ptr<TargetState>, std::shared_ptr<SessionState>> findTarget(
+    XrGraspTargetSDFG target) {
+  auto t = targets().find(key(target));
+  auto s = t == nullptr ? nullptr : t->session.lock();
+  if (s == nullptr) return {nullptr, nullptr};
+  return {t, s};
+}
+
+XrResult verifyPlacement(const char* cmd, const SessionState& s,
+                         const XrGraspTargetPlacementSDFG* placement) {
+  SDFG_VERIFY_TYPE(cmd, placement, XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG);
+  SDFG_VERIFY(cmd, placement->space != XR_NULL_HANDLE, XR_ERROR_HANDLE_INVALID,
+              "(placement->space) is XR_NULL_HANDLE");
+  SDFG_VERIFY(cmd, s.spaces.count(key(placement->space)) != 0, XR_ERROR_HANDLE_INVALID,
+              "(placement->space) is not a reference or action space of this session");
+  SDFG_VERIFY(cmd, isFinitePose(placement->pose), XR_ERROR_VALIDATION_FAILURE,
+              "(placement->pose) is not finite");
+  SDFG_VERIFY(cmd, isUnitQuaternion(placement->pose.orientation), XR_ERROR_POSE_INVALID,
+              "(placement->pose.orientation) is not a unit quaternion");
+  return XR_SUCCESS;
+}
+
+// Checks the CPU arrays: counts, pointers, finite coordinates. Indices and degenerate
+// triangles are checked by makeMesh.
+XrResult verifyVertices(const char* cmd, const XrGraspTargetVerticesSDFG* v, bool update,
+                        uint32_t expectedVertexCount) {
+  SDFG_VERIFY(cmd, v->vertexCount >= 3 && v->vertexCount <= XR_MAX_GRASP_TARGET_VERTICES_SDFG,
+              XR_ERROR_VALIDATION_FAILURE, "(vertexCount) is %u, must be in 3..%u", v->vertexCount,
+              XR_MAX_GRASP_TARGET_VERTICES_SDFG);
+  SDFG_VERIFY_NOT_NULL(cmd, v->vertices);
+  if (update) {
+    SDFG_VERIFY(cmd, v->vertexCount == expectedVertexCount, XR_ERROR_VALIDATION_FAILURE,
+                "(vertexCount) is %u, the target has %u", v->vertexCount, expectedVertexCount);
+    SDFG_VERIFY(cmd, v->indexCount == 0 && v->indices == nullptr, XR_ERROR_VALIDATION_FAILURE,
+                "(indexCount) and (indices) must be 0 and NULL on update: the topology is fixed");
+  } else {
+    SDFG_VERIFY(cmd,
+                v->indexCount >= 3 && v->indexCount % 3 == 0 &&
+                    v->indexCount <= XR_MAX_GRASP_TARGET_INDICES_SDFG,
+                XR_ERROR_VALIDATION_FAILURE, "(indexCount) is %u, must be a multiple of 3 in 3..%u",
+                v->indexCount, XR_MAX_GRASP_TARGET_INDICES_SDFG);
+    SDFG_VERIFY_NOT_NULL(cmd, v->indices);
+  }
+  for (uint32_t i = 0; i < v->vertexCount; ++i) {
+    const XrVector3f& p = v->vertices[i];
+    SDFG_VERIFY(cmd, std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z),
+                XR_ERROR_VALIDATION_FAILURE, "(vertices[%u]) is not finite", i);
+  }
+  return XR_SUCCESS;
+}
+
+std::vector<glm::vec3> toPositions(const XrGraspTargetVerticesSDFG& v) {
+  std::vector<glm::vec3> out(v.vertexCount);
+  for (uint32_t i = 0; i < v.vertexCount; ++i)
+    out[i] = glm::vec3(v.vertices[i].x, v.vertices[i].y, v.vertices[i].z);
+  return out;
+}
+
+}  // namespace
+
+XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
+                                                const XrGraspTargetCreateInfoSDFG* createInfo,
+                                                XrGraspTargetSDFG* target) {
+  constexpr const char* cmd = "xrCreateGraspTargetSDFG";
+  SDFG_ENTRY_BEGIN
+  auto s = findSession(session);
+  SDFG_VERIFY(cmd, s != nullptr, XR_ERROR_HANDLE_INVALID, "(session) is not valid");
+  SDFG_VERIFY_TYPE(cmd, createInfo, XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG);
+  SDFG_VERIFY_NOT_NULL(cmd, target);
+  const auto* arrays = findInChain<const XrGraspTargetVerticesSDFG>(
+      createInfo->next, XR_TYPE_GRASP_TARGET_VERTICES_SDFG);
+  const auto* buffers = findInChain<const XrGraspTargetVulkanBuffersSDFG>(
+      createInfo->next, XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG);
+  SDFG_VERIFY(cmd, (arrays != nullptr) != (buffers != nullptr), XR_ERROR_VALIDATION_FAILURE,
+              "(createInfo->next) must chain exactly one XrGraspTargetVerticesSDFG or "
+              "XrGraspTargetVulkanBuffersSDFG");
+  std::lock_guard lock(s->mutex);
+  SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
+  if (XrResult r = verifyPlacement(cmd, *s, &createInfo->placement); r != XR_SUCCESS) return r;
+  if (buffers != nullptr) {
+    SDFG_VERIFY(cmd, s->vulkan, XR_ERROR_GRAPHICS_DEVICE_INVALID,
+                "Vulkan buffers need a session with a Vulkan graphics binding");
+    return logError(XR_ERROR_FEATURE_UNSUPPORTED, cmd,
+                    "Vulkan buffer targets are not supported by this build yet; pass arrays");
+  }
+  if (XrResult r = verifyVertices(cmd, arrays, false, 0); r != XR_SUCCESS) return r;
+  auto mesh = makeMesh(toPositions(*arrays),
+                       std::span<const uint32_t>(arrays->indices, arrays->indexCount));
+  SDFG_VERIFY(cmd, mesh.ok(), toXrResult(mesh.ok() ? Status::ok : mesh.error().code), "%s",
+              mesh.ok() ? "" : mesh.error().message.c_str());
+  auto t = std::make_shared<TargetState>();
+  t->handle = newLayerHandle();
+  t->session = s;
+  t->space = createInfo->placement.space;
+  t->pose = createInfo->placement.pose;
+  t->vertexCount = arrays->vertexCount;
+  if (Status st = s->grasp->addTarget(t->handle, *mesh); st != Status::ok)
+    return logError(toXrResult(st), cmd, "the target could not be built (%s)", toString(st));
+  s->targets[t->handle] = t;
+  *target = fromKey<XrGraspTargetSDFG>(t->handle);
+  const uint64_t handle = t->handle;
+  targets().insert(handle, std::move(t));
+  return XR_SUCCESS;
+  SDFG_ENTRY_END(cmd)
+}
+
+XrResult XRAPI_CALL SdfgXrDestroyGraspTargetSDFG(XrGraspTargetSDFG target) {
+  constexpr const char* cmd = "xrDestroyGraspTargetSDFG";
+  SDFG_ENTRY_BEGIN
+  auto [t, s] = findTarget(target);
+  SDFG_VERIFY(cmd, t != nullptr, XR_ERROR_HANDLE_INVALID, "(target) is not valid");
+  std::lock_guard lock(s->mutex);
+  // A hand holding it lets go; its fingers return to the user's pose at the next locate.
+  if (s->grasp != nullptr) s->grasp->removeTarget(t->handle);
+  s->targets.erase(t->handle);
+  targets().erase(t->handle);
+  return XR_SUCCESS;
+  SDFG_ENTRY_END(cmd)
+}
+
+XrResult XRAPI_CALL SdfgXrUpdateGraspTargetVerticesSDFG(XrGraspTargetSDFG target,
+                                                        const void* vertices) {
+  constexpr const char* cmd = "xrUpdateGraspTargetVerticesSDFG";
+  SDFG_ENTRY_BEGIN
+  auto [t, s] = findTarget(target);
+  SDFG_VERIFY(cmd, t != nullptr, XR_ERROR_HANDLE_INVALID, "(target) is not valid");
+  SDFG_VERIFY_NOT_NULL(cmd, vertices);
+  const auto* base = static_cast<const XrBaseInStructure*>(vertices);
+  if (base->type == XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG)
+    return logError(XR_ERROR_FEATURE_UNSUPPORTED, cmd,
+                    "Vulkan buffer targets are not supported yet");
+  SDFG_VERIFY(cmd, base->type == XR_TYPE_GRASP_TARGET_VERTICES_SDFG, XR_ERROR_VALIDATION_FAILURE,
+              "(vertices->type) is %d, expected XR_TYPE_GRASP_TARGET_VERTICES_SDFG",
+              int(base->type));
+  const auto* v = static_cast<const XrGraspTargetVerticesSDFG*>(vertices);
+  if (XrResult r = verifyVertices(cmd, v, true, t->vertexCount); r != XR_SUCCESS) return r;
+  const std::vector<glm::vec3> positions = toPositions(*v);
+  std::lock_guard lock(s->mutex);
+  SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
+  if (Status st = s->grasp->updateTargetVertices(t->handle, positions); st != Status::ok)
+    return logError(toXrResult(st), cmd, "the vertices were refused (%s)", toString(st));
+  return XR_SUCCESS;
+  SDFG_ENTRY_END(cmd)
+}
+
+XrResult XRAPI_CALL SdfgXrSetGraspTargetPlacementSDFG(XrGraspTargetSDFG target,
+                                                      const XrGraspTargetPlacementSDFG* placement) {
+  constexpr const char* cmd = "xrSetGraspTargetPlacementSDFG";
+  SDFG_ENTRY_BEGIN
+  auto [t, s] = findTarget(target);
+  SDFG_VERIFY(cmd, t != nullptr, XR_ERROR_HANDLE_INVALID, "(target) is not valid");
+  std::lock_guard lock(s->mutex);
+  if (XrResult r = verifyPlacement(cmd, *s, placement); r != XR_SUCCESS) return r;
+  t->space = placement->space;
+  t->pose = placement->pose;
+  return XR_SUCCESS;
+  SDFG_ENTRY_END(cmd)
+}
+
+XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
+                                            const XrGraspStateGetInfoSDFG* getInfo,
+                                            XrGraspStateSDFG* state) {
+  constexpr const char* cmd = "xrGetGraspStateSDFG";
+  SDFG_ENTRY_BEGIN
+  auto s = findSession(session);
+  SDFG_VERIFY(cmd, s != nullptr, XR_ERROR_HANDLE_INVALID, "(session) is not valid");
+  SDFG_VERIFY_TYPE(cmd, getInfo, XR_TYPE_GRASP_STATE_GET_INFO_SDFG);
+  SDFG_VERIFY_TYPE(cmd, state, XR_TYPE_GRASP_STATE_SDFG);
+  SDFG_VERIFY(cmd, getInfo->hand == XR_HAND_LEFT_EXT || getInfo->hand == XR_HAND_RIGHT_EXT,
+              XR_ERROR_VALIDATION_FAILURE, "(getInfo->hand) is %d", int(getInfo->hand));
+  const Hand hand = getInfo->hand == XR_HAND_LEFT_EXT ? Hand::left : Hand::right;
+  std::lock_guard lock(s->mutex);
+  SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
+  const HandGrasp& g = s->grasp->grasp(hand);
+  const bool held = g.holding && g.solves > 0;
+  state->isGrasping = held ? XR_TRUE : XR_FALSE;
+  state->target = held ? fromKey<XrGraspTargetSDFG>(g.target) : XR_NULL_HANDLE;
+  state->squeeze = s->squeeze[hand == Hand::left ? 0 : 1];
+  for (int f = 0; f < kFingerCount; ++f) {
+    XrGraspFingerStateSDFG& out = state->fingers[f];
+    const FingerState& fs = g.result.fingers[f];
+    out.curl = held ? fs.curl : 0.0f;
+    out.inContact = held && fs.contact ? XR_TRUE : XR_FALSE;
+    const glm::vec3 p = held ? g.objectFromHand.transformPoint(fs.contactPoint) : glm::vec3(0.0f);
+    out.contactPoint = {p.x, p.y, p.z};
+    out.distance = held ? fs.distance : 0.0f;
+  }
+  return XR_SUCCESS;
+  SDFG_ENTRY_END(cmd)
+}
+
+XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession session,
+                                              const XrGraspOptionsSDFG* options) {
+  constexpr const char* cmd = "xrSetGraspOptionsSDFG";
+  SDFG_ENTRY_BEGIN
+  auto s = findSession(session);
+  SDFG_VERIFY(cmd, s != nullptr, XR_ERROR_HANDLE_INVALID, "(session) is not valid");
+  SDFG_VERIFY_TYPE(cmd, options, XR_TYPE_GRASP_OPTIONS_SDFG);
+  const XrGraspOptionsSDFG& o = *options;
+  SDFG_VERIFY(cmd,
+              o.solver >= XR_GRASP_SOLVER_DEFAULT_SDFG && o.solver <= XR_GRASP_SOLVER_OURS_SDFG,
+              XR_ERROR_VALIDATION_FAILURE, "(options->solver) is %d", int(o.solver));
+  SDFG_VERIFY(cmd, o.tipRadius == 0.0f || (o.tipRadius > 0.0f && o.tipRadius <= 0.05f),
+              XR_ERROR_VALIDATION_FAILURE, "(options->tipRadius) must be 0 or in (0, 0.05]");
+  const bool boxZero = o.boxSize.x == 0.0f && o.boxSize.y == 0.0f && o.boxSize.z == 0.0f;
+  auto inBox = [](float v) { return v > 0.0f && v <= 1.0f; };
+  SDFG_VERIFY(cmd, boxZero || (inBox(o.boxSize.x) && inBox(o.boxSize.y) && inBox(o.boxSize.z)),
+              XR_ERROR_VALIDATION_FAILURE, "(options->boxSize) must be all 0 or each in (0, 1]");
+  SDFG_VERIFY(
+      cmd,
+      boxZero || (isFinitePose(o.boxPose) && std::abs(o.boxPose.position.x) <= 1.0f &&
+                  std::abs(o.boxPose.position.y) <= 1.0f && std::abs(o.boxPose.position.z) <= 1.0f),
+      XR_ERROR_VALIDATION_FAILURE, "(options->boxPose) must be finite, within 1 m");
+  SDFG_VERIFY(cmd, boxZero || isUnitQuaternion(o.boxPose.orientation), XR_ERROR_POSE_INVALID,
+              "(options->boxPose.orientation) is not a unit quaternion");
+  SDFG_VERIFY(cmd,
+              o.resolution == 0 ||
+                  (o.resolution >= kMinGridResolution && o.resolution <= kMaxGridResolution),
+              XR_ERROR_VALIDATION_FAILURE, "(options->resolution) is %u, must be 0 or 2..128",
+              o.resolution);
+  SDFG_VERIFY(cmd, o.curlStep == 0.0f || (o.curlStep >= 1e-5f && o.curlStep <= 1.0f),
+              XR_ERROR_VALIDATION_FAILURE, "(options->curlStep) must be 0 or in [1e-5, 1]");
+  SDFG_VERIFY(cmd, o.grabThreshold == 0.0f || (o.grabThreshold > 0.0f && o.grabThreshold <= 1.0f),
+              XR_ERROR_VALIDATION_FAILURE, "(options->grabThreshold) must be 0 or in (0, 1]");
+
+  std::lock_guard lock(s->mutex);
+  SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
+  GraspSettings settings = settingsFromConfig(s->instance->config);
+  if (o.solver == XR_GRASP_SOLVER_PAPER_SDFG) settings.solver = "paper";
+  if (o.solver == XR_GRASP_SOLVER_OURS_SDFG) settings.solver = "ours";
+  if (o.tipRadius > 0.0f) settings.solverOptions.threshold = o.tipRadius;
+  if (!boxZero) {
+    settings.box.handFromBox = toPose(o.boxPose);
+    settings.box.size = glm::vec3(o.boxSize.x, o.boxSize.y, o.boxSize.z);
+  }
+  if (o.resolution != 0) settings.box.resolution = glm::uvec3(o.resolution);
+  if (o.curlStep != 0.0f) settings.solverOptions.da = o.curlStep;
+  if (o.grabThreshold != 0.0f) settings.grabThreshold = o.grabThreshold;
+  if (Status st = s->grasp->configure(settings); st != Status::ok)
+    return logError(st == Status::invalid_argument && o.solver == XR_GRASP_SOLVER_OURS_SDFG
+                        ? XR_ERROR_FEATURE_UNSUPPORTED
+                        : toXrResult(st),
+                    cmd, "the options were refused (%s; solver '%s')", toString(st),
+                    settings.solver.c_str());
+  s->settings = settings;
+  return XR_SUCCESS;
+  SDFG_ENTRY_END(cmd)
+}
+
+}  // namespace sdfg::layer

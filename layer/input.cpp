@@ -1,0 +1,242 @@
+// The layer's own input: an action set with a squeeze value and a grip pose per hand, merged
+// into the app's suggested bindings, attached with the app's sets and synced with every app sync
+// (notes/openxr-layer.md section 12). Priority 0 and bindings added only to profiles the app
+// suggests, so the app's actions report exactly what they would without the layer.
+#include <cstring>
+#include <vector>
+
+#include "intercepts.h"
+#include "log.h"
+#include "state.h"
+
+namespace sdfg::layer {
+namespace {
+
+struct ProfileInputs {
+  const char* profile;
+  const char* squeeze;  // under /user/hand/<hand>/
+};
+
+// Profiles the layer binds; a float action reads a click as 0 or 1.
+constexpr ProfileInputs kProfiles[] = {
+    {"/interaction_profiles/oculus/touch_controller", "input/squeeze/value"},
+    {"/interaction_profiles/valve/index_controller", "input/squeeze/value"},
+    {"/interaction_profiles/htc/vive_controller", "input/squeeze/click"},
+    {"/interaction_profiles/microsoft/motion_controller", "input/squeeze/click"},
+    {"/interaction_profiles/khr/simple_controller", "input/select/click"},
+};
+
+constexpr const char* kHandNames[2] = {"left", "right"};
+
+// Paths of kProfiles, resolved once per instance.
+std::vector<ProfilePaths> resolveProfiles(InstanceState& instance) {
+  std::vector<ProfilePaths> out;
+  auto path = [&](const std::string& s) {
+    XrPath p = XR_NULL_PATH;
+    return instance.next.xrStringToPath(instance.handle, s.c_str(), &p) == XR_SUCCESS
+               ? p
+               : XR_NULL_PATH;
+  };
+  for (const ProfileInputs& in : kProfiles) {
+    ProfilePaths pp;
+    pp.profile = path(in.profile);
+    for (int h = 0; h < 2; ++h) {
+      const std::string hand = std::string("/user/hand/") + kHandNames[h] + "/";
+      pp.squeeze[h] = path(hand + in.squeeze);
+      pp.grip[h] = path(hand + "input/grip/pose");
+    }
+    out.push_back(pp);
+  }
+  return out;
+}
+
+const ProfilePaths* findProfile(const InstanceState& instance, XrPath profile) {
+  for (const ProfilePaths& p : instance.profiles) {
+    if (p.profile == profile && profile != XR_NULL_PATH) return &p;
+  }
+  return nullptr;
+}
+
+void appendLayerBindings(const InstanceState& instance, const ProfilePaths& paths,
+                         std::vector<XrActionSuggestedBinding>& out) {
+  for (int h = 0; h < 2; ++h) {
+    out.push_back({instance.squeezeAction, paths.squeeze[h]});
+    out.push_back({instance.gripAction, paths.grip[h]});
+  }
+}
+
+}  // namespace
+
+void createLayerActions(InstanceState& instance) {
+  constexpr const char* cmd = "xrCreateInstance";
+  auto& next = instance.next;
+  if (next.xrCreateActionSet == nullptr || next.xrCreateAction == nullptr ||
+      next.xrStringToPath == nullptr)
+    return;
+  for (int h = 0; h < 2; ++h) {
+    const std::string p = std::string("/user/hand/") + kHandNames[h];
+    if (next.xrStringToPath(instance.handle, p.c_str(), &instance.handPaths[h]) != XR_SUCCESS)
+      return;
+  }
+  instance.profiles = resolveProfiles(instance);
+  XrActionSetCreateInfo setInfo{XR_TYPE_ACTION_SET_CREATE_INFO};
+  std::strcpy(setInfo.actionSetName, "sdfg_autograsp_layer");
+  std::strcpy(setInfo.localizedActionSetName, "SDF Autograsp layer");
+  setInfo.priority = 0;  // never outranks the app's sets on a shared input
+  if (next.xrCreateActionSet(instance.handle, &setInfo, &instance.actionSet) != XR_SUCCESS) {
+    SDFG_LOG_WARN(cmd, "could not create the layer's action set; no grab input");
+    instance.actionSet = XR_NULL_HANDLE;
+    return;
+  }
+  XrActionCreateInfo info{XR_TYPE_ACTION_CREATE_INFO};
+  info.countSubactionPaths = 2;
+  info.subactionPaths = instance.handPaths.data();
+  info.actionType = XR_ACTION_TYPE_FLOAT_INPUT;
+  std::strcpy(info.actionName, "sdfg_autograsp_squeeze");
+  std::strcpy(info.localizedActionName, "SDF Autograsp squeeze");
+  XrResult r = next.xrCreateAction(instance.actionSet, &info, &instance.squeezeAction);
+  info.actionType = XR_ACTION_TYPE_POSE_INPUT;
+  std::strcpy(info.actionName, "sdfg_autograsp_grip");
+  std::strcpy(info.localizedActionName, "SDF Autograsp grip");
+  if (r == XR_SUCCESS) r = next.xrCreateAction(instance.actionSet, &info, &instance.gripAction);
+  if (r != XR_SUCCESS) {
+    SDFG_LOG_WARN(cmd, "could not create the layer's actions (%d); no grab input", int(r));
+    if (next.xrDestroyActionSet != nullptr) next.xrDestroyActionSet(instance.actionSet);
+    instance.actionSet = XR_NULL_HANDLE;
+  }
+}
+
+XrResult XRAPI_CALL SdfgXrSuggestInteractionProfileBindings(
+    XrInstance instance, const XrInteractionProfileSuggestedBinding* suggested) {
+  constexpr const char* cmd = "xrSuggestInteractionProfileBindings";
+  SDFG_ENTRY_BEGIN
+  auto state = instances().find(key(instance));
+  if (state == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(instance) is not valid");
+  auto& next = state->next;
+  if (state->actionSet == XR_NULL_HANDLE || suggested == nullptr ||
+      suggested->type != XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING ||
+      (suggested->countSuggestedBindings > 0 && suggested->suggestedBindings == nullptr))
+    return next.xrSuggestInteractionProfileBindings(instance, suggested);
+  const ProfilePaths* paths = findProfile(*state, suggested->interactionProfile);
+  if (paths == nullptr) return next.xrSuggestInteractionProfileBindings(instance, suggested);
+  // A second suggestion for a profile replaces the first, so the layer's bindings ride along
+  // with every one the app makes.
+  std::vector<XrActionSuggestedBinding> merged(
+      suggested->suggestedBindings,
+      suggested->suggestedBindings + suggested->countSuggestedBindings);
+  appendLayerBindings(*state, *paths, merged);
+  XrInteractionProfileSuggestedBinding copy = *suggested;
+  copy.countSuggestedBindings = uint32_t(merged.size());
+  copy.suggestedBindings = merged.data();
+  XrResult r = next.xrSuggestInteractionProfileBindings(instance, &copy);
+  if (XR_FAILED(r)) {
+    // Never fail the app's call because of the layer's additions.
+    const XrResult own = next.xrSuggestInteractionProfileBindings(instance, suggested);
+    if (XR_SUCCEEDED(own))
+      SDFG_LOG_WARN(cmd,
+                    "the runtime refused the layer's bindings (%d); no grab input on this profile",
+                    int(r));
+    r = own;
+  }
+  if (XR_SUCCEEDED(r)) {
+    std::lock_guard lock(state->inputMutex);
+    state->appSuggestedProfiles.insert(suggested->interactionProfile);
+  }
+  return r;
+  SDFG_ENTRY_END(cmd)
+}
+
+XrResult XRAPI_CALL SdfgXrAttachSessionActionSets(XrSession session,
+                                                  const XrSessionActionSetsAttachInfo* info) {
+  constexpr const char* cmd = "xrAttachSessionActionSets";
+  SDFG_ENTRY_BEGIN
+  auto s = sessions().find(key(session));
+  if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
+  InstanceState& inst = *s->instance;
+  auto& next = inst.next;
+  if (inst.actionSet == XR_NULL_HANDLE || info == nullptr ||
+      info->type != XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO ||
+      (info->countActionSets > 0 && info->actionSets == nullptr))
+    return next.xrAttachSessionActionSets(session, info);
+  {
+    // An app without suggestions gets the layer's alone, on every profile it knows.
+    std::lock_guard lock(inst.inputMutex);
+    if (inst.appSuggestedProfiles.empty()) {
+      for (const ProfilePaths& paths : inst.profiles) {
+        if (paths.profile == XR_NULL_PATH) continue;
+        std::vector<XrActionSuggestedBinding> own;
+        appendLayerBindings(inst, paths, own);
+        XrInteractionProfileSuggestedBinding b{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+        b.interactionProfile = paths.profile;
+        b.countSuggestedBindings = uint32_t(own.size());
+        b.suggestedBindings = own.data();
+        (void)next.xrSuggestInteractionProfileBindings(inst.handle, &b);
+      }
+    }
+  }
+  std::vector<XrActionSet> sets(info->actionSets, info->actionSets + info->countActionSets);
+  sets.push_back(inst.actionSet);
+  XrSessionActionSetsAttachInfo copy = *info;
+  copy.countActionSets = uint32_t(sets.size());
+  copy.actionSets = sets.data();
+  XrResult r = next.xrAttachSessionActionSets(session, &copy);
+  if (XR_FAILED(r)) {
+    const XrResult own = next.xrAttachSessionActionSets(session, info);
+    if (XR_SUCCEEDED(own))
+      SDFG_LOG_WARN(cmd, "could not attach the layer's action set (%d)", int(r));
+    return own;
+  }
+  std::lock_guard lock(s->mutex);
+  s->attached = true;
+  for (int h = 0; h < 2; ++h) {
+    XrActionSpaceCreateInfo spaceInfo{XR_TYPE_ACTION_SPACE_CREATE_INFO};
+    spaceInfo.action = inst.gripAction;
+    spaceInfo.subactionPath = inst.handPaths[h];
+    spaceInfo.poseInActionSpace.orientation.w = 1.0f;
+    if (next.xrCreateActionSpace(session, &spaceInfo, &s->gripSpaces[h]) != XR_SUCCESS)
+      s->gripSpaces[h] = XR_NULL_HANDLE;
+  }
+  XrReferenceSpaceCreateInfo local{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};
+  local.referenceSpaceType = XR_REFERENCE_SPACE_TYPE_LOCAL;
+  local.poseInReferenceSpace.orientation.w = 1.0f;
+  if (next.xrCreateReferenceSpace(session, &local, &s->localSpace) != XR_SUCCESS)
+    s->localSpace = XR_NULL_HANDLE;
+  return r;
+  SDFG_ENTRY_END(cmd)
+}
+
+XrResult XRAPI_CALL SdfgXrSyncActions(XrSession session, const XrActionsSyncInfo* info) {
+  constexpr const char* cmd = "xrSyncActions";
+  SDFG_ENTRY_BEGIN
+  auto s = sessions().find(key(session));
+  if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
+  InstanceState& inst = *s->instance;
+  bool attached;
+  {
+    std::lock_guard lock(s->mutex);
+    attached = s->attached;
+  }
+  if (!attached || info == nullptr || info->type != XR_TYPE_ACTIONS_SYNC_INFO ||
+      (info->countActiveActionSets > 0 && info->activeActionSets == nullptr))
+    return inst.next.xrSyncActions(session, info);
+  std::vector<XrActiveActionSet> active(info->activeActionSets,
+                                        info->activeActionSets + info->countActiveActionSets);
+  active.push_back({inst.actionSet, XR_NULL_PATH});
+  XrActionsSyncInfo copy = *info;
+  copy.countActiveActionSets = uint32_t(active.size());
+  copy.activeActionSets = active.data();
+  const XrResult r = inst.next.xrSyncActions(session, &copy);
+  if (r == XR_SUCCESS || r == XR_SESSION_NOT_FOCUSED) {
+    // A failure in the layer's own work never changes the app's result.
+    try {
+      std::lock_guard lock(s->mutex);
+      updateGrasps(*s);
+    } catch (...) {
+      SDFG_LOG_WARN(cmd, "grab update failed; hands pass through this frame");
+    }
+  }
+  return r;
+  SDFG_ENTRY_END(cmd)
+}
+
+}  // namespace sdfg::layer

@@ -1,0 +1,49 @@
+// Every command the layer intercepts, named SdfgXr<Command> (never xr<Command>: a layer that
+// defines the loader's names can bind to the loader's copies through ELF interposition).
+#pragma once
+
+#include "state.h"
+#include "xr_includes.h"
+
+namespace sdfg::layer {
+
+// session.cpp
+XrResult XRAPI_CALL SdfgXrGetSystemProperties(XrInstance, XrSystemId, XrSystemProperties*);
+XrResult XRAPI_CALL SdfgXrCreateSession(XrInstance, const XrSessionCreateInfo*, XrSession*);
+XrResult XRAPI_CALL SdfgXrDestroySession(XrSession);
+XrResult XRAPI_CALL SdfgXrWaitFrame(XrSession, const XrFrameWaitInfo*, XrFrameState*);
+XrResult XRAPI_CALL SdfgXrCreateReferenceSpace(XrSession, const XrReferenceSpaceCreateInfo*,
+                                               XrSpace*);
+XrResult XRAPI_CALL SdfgXrCreateActionSpace(XrSession, const XrActionSpaceCreateInfo*, XrSpace*);
+XrResult XRAPI_CALL SdfgXrDestroySpace(XrSpace);
+
+// input.cpp
+XrResult XRAPI_CALL
+SdfgXrSuggestInteractionProfileBindings(XrInstance, const XrInteractionProfileSuggestedBinding*);
+XrResult XRAPI_CALL SdfgXrAttachSessionActionSets(XrSession, const XrSessionActionSetsAttachInfo*);
+XrResult XRAPI_CALL SdfgXrSyncActions(XrSession, const XrActionsSyncInfo*);
+
+// hands.cpp
+XrResult XRAPI_CALL SdfgXrCreateHandTrackerEXT(XrSession, const XrHandTrackerCreateInfoEXT*,
+                                               XrHandTrackerEXT*);
+XrResult XRAPI_CALL SdfgXrDestroyHandTrackerEXT(XrHandTrackerEXT);
+XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT, const XrHandJointsLocateInfoEXT*,
+                                              XrHandJointLocationsEXT*);
+
+// extension.cpp (XR_SDFG_auto_grasp)
+XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession, const XrGraspTargetCreateInfoSDFG*,
+                                                XrGraspTargetSDFG*);
+XrResult XRAPI_CALL SdfgXrDestroyGraspTargetSDFG(XrGraspTargetSDFG);
+XrResult XRAPI_CALL SdfgXrUpdateGraspTargetVerticesSDFG(XrGraspTargetSDFG, const void*);
+XrResult XRAPI_CALL SdfgXrSetGraspTargetPlacementSDFG(XrGraspTargetSDFG,
+                                                      const XrGraspTargetPlacementSDFG*);
+XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession, const XrGraspStateGetInfoSDFG*,
+                                            XrGraspStateSDFG*);
+XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession, const XrGraspOptionsSDFG*);
+
+// input.cpp: creates the layer's action set and actions on a new instance.
+void createLayerActions(InstanceState& instance);
+// hands.cpp: destroys the layer's internal trackers of a session (before it goes away).
+void destroyInternalTrackers(SessionState& session);
+
+}  // namespace sdfg::layer

@@ -1,0 +1,171 @@
+// Sessions and what the layer tracks on them: system properties (hand tracking it provides),
+// session create/destroy, the predicted display time, and the app's spaces.
+#include "intercepts.h"
+#include "log.h"
+#include "state.h"
+
+namespace sdfg::layer {
+namespace {
+
+std::shared_ptr<InstanceState> instanceOf(XrInstance handle) {
+  return instances().find(key(handle));
+}
+
+}  // namespace
+
+XrResult XRAPI_CALL SdfgXrGetSystemProperties(XrInstance instance, XrSystemId systemId,
+                                              XrSystemProperties* properties) {
+  constexpr const char* cmd = "xrGetSystemProperties";
+  SDFG_ENTRY_BEGIN
+  auto state = instanceOf(instance);
+  if (state == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(instance) is not valid");
+  if (!state->provideHandTracking || properties == nullptr)
+    return state->next.xrGetSystemProperties(instance, systemId, properties);
+  // The runtime does not know XR_EXT_hand_tracking: unlink its struct for the call down (core
+  // validation below would report it), then link it back and answer it.
+  auto* chain = reinterpret_cast<XrBaseOutStructure*>(properties);
+  XrBaseOutStructure* prev = chain;
+  XrSystemHandTrackingPropertiesEXT* hand = nullptr;
+  for (XrBaseOutStructure* p = chain->next; p != nullptr; prev = p, p = p->next) {
+    if (p->type == XR_TYPE_SYSTEM_HAND_TRACKING_PROPERTIES_EXT) {
+      hand = reinterpret_cast<XrSystemHandTrackingPropertiesEXT*>(p);
+      prev->next = p->next;
+      break;
+    }
+  }
+  const XrResult r = state->next.xrGetSystemProperties(instance, systemId, properties);
+  if (hand != nullptr) {
+    hand->next = prev->next;
+    prev->next = reinterpret_cast<XrBaseOutStructure*>(hand);
+    // Joints come from the controllers' grip pose and squeeze; with synthesis switched off
+    // there is nothing to drive them.
+    if (XR_SUCCEEDED(r)) hand->supportsHandTracking = state->config.synthesis ? XR_TRUE : XR_FALSE;
+  }
+  return r;
+  SDFG_ENTRY_END(cmd)
+}
+
+XrResult XRAPI_CALL SdfgXrCreateSession(XrInstance instance, const XrSessionCreateInfo* info,
+                                        XrSession* session) {
+  constexpr const char* cmd = "xrCreateSession";
+  SDFG_ENTRY_BEGIN
+  auto state = instanceOf(instance);
+  if (state == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(instance) is not valid");
+  const XrResult r = state->next.xrCreateSession(instance, info, session);
+  if (XR_FAILED(r)) return r;
+  auto s = std::make_shared<SessionState>();
+  s->handle = *session;
+  s->instance = state;
+  if (const auto* vk = findInChain<const XrGraphicsBindingVulkanKHR>(
+          info->next, XR_TYPE_GRAPHICS_BINDING_VULKAN_KHR)) {
+    s->vulkan = true;
+    s->vulkanBinding = *vk;
+    s->vulkanBinding.next = nullptr;
+  }
+  s->settings = settingsFromConfig(state->config);
+  // The SDF is built on the CPU for now; the Vulkan backend plugs in behind SdfBackend.
+  s->grasp = std::make_unique<GraspSession>(makeCpuSdfBackend(2));
+  if (Status st = s->grasp->configure(s->settings); st != Status::ok) {
+    SDFG_LOG_WARN(cmd, "configured solver '%s' is not usable (%s); using 'paper'",
+                  s->settings.solver.c_str(), toString(st));
+    s->settings.solver = "paper";
+    (void)s->grasp->configure(s->settings);
+  }
+  sessions().insert(key(*session), std::move(s));
+  return r;
+  SDFG_ENTRY_END(cmd)
+}
+
+XrResult XRAPI_CALL SdfgXrDestroySession(XrSession session) {
+  constexpr const char* cmd = "xrDestroySession";
+  SDFG_ENTRY_BEGIN
+  auto s = sessions().find(key(session));
+  if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
+  {
+    std::lock_guard lock(s->mutex);
+    destroyInternalTrackers(*s);
+  }
+  const XrResult r = s->instance->next.xrDestroySession(session);
+  if (XR_SUCCEEDED(r)) {
+    // Children go with the session: its trackers, targets and spaces.
+    trackers().eraseIf([&](const TrackerState& t) { return t.session.lock() == s; });
+    targets().eraseIf([&](const TargetState& t) { return t.session.lock() == s; });
+    spaceOwners().eraseIf([&](const SessionState& owner) { return &owner == s.get(); });
+    std::lock_guard lock(s->mutex);
+    s->targets.clear();
+    s->grasp.reset();
+    sessions().erase(key(session));
+  }
+  return r;
+  SDFG_ENTRY_END(cmd)
+}
+
+XrResult XRAPI_CALL SdfgXrWaitFrame(XrSession session, const XrFrameWaitInfo* info,
+                                    XrFrameState* frameState) {
+  constexpr const char* cmd = "xrWaitFrame";
+  SDFG_ENTRY_BEGIN
+  auto s = sessions().find(key(session));
+  if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
+  const XrResult r = s->instance->next.xrWaitFrame(session, info, frameState);
+  if (XR_SUCCEEDED(r) && frameState != nullptr) {
+    std::lock_guard lock(s->mutex);
+    s->predictedTime = frameState->predictedDisplayTime;
+  }
+  return r;
+  SDFG_ENTRY_END(cmd)
+}
+
+XrResult XRAPI_CALL SdfgXrCreateReferenceSpace(XrSession session,
+                                               const XrReferenceSpaceCreateInfo* info,
+                                               XrSpace* space) {
+  constexpr const char* cmd = "xrCreateReferenceSpace";
+  SDFG_ENTRY_BEGIN
+  auto s = sessions().find(key(session));
+  if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
+  const XrResult r = s->instance->next.xrCreateReferenceSpace(session, info, space);
+  if (XR_SUCCEEDED(r)) {
+    std::lock_guard lock(s->mutex);
+    s->spaces.insert(key(*space));
+    spaceOwners().insert(key(*space), s);
+  }
+  return r;
+  SDFG_ENTRY_END(cmd)
+}
+
+XrResult XRAPI_CALL SdfgXrCreateActionSpace(XrSession session, const XrActionSpaceCreateInfo* info,
+                                            XrSpace* space) {
+  constexpr const char* cmd = "xrCreateActionSpace";
+  SDFG_ENTRY_BEGIN
+  auto s = sessions().find(key(session));
+  if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
+  const XrResult r = s->instance->next.xrCreateActionSpace(session, info, space);
+  if (XR_SUCCEEDED(r)) {
+    std::lock_guard lock(s->mutex);
+    s->spaces.insert(key(*space));
+    spaceOwners().insert(key(*space), s);
+  }
+  return r;
+  SDFG_ENTRY_END(cmd)
+}
+
+XrResult XRAPI_CALL SdfgXrDestroySpace(XrSpace space) {
+  constexpr const char* cmd = "xrDestroySpace";
+  SDFG_ENTRY_BEGIN
+  auto s = spaceOwners().find(key(space));
+  if (s == nullptr) {
+    // A space this layer did not see created (an anchor of another extension): pass it down.
+    auto any = instances().any();
+    if (any == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(space) is not valid");
+    return any->next.xrDestroySpace(space);
+  }
+  const XrResult r = s->instance->next.xrDestroySpace(space);
+  if (XR_SUCCEEDED(r)) {
+    std::lock_guard lock(s->mutex);
+    s->spaces.erase(key(space));
+    spaceOwners().erase(key(space));
+  }
+  return r;
+  SDFG_ENTRY_END(cmd)
+}
+
+}  // namespace sdfg::layer

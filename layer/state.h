@@ -1,0 +1,207 @@
+// Per-instance, per-session and per-object state of the layer, in handle-keyed maps behind
+// mutexes. Lookups on app input return null for an unknown handle; the caller answers
+// XR_ERROR_HANDLE_INVALID. Objects are shared_ptr so a call in flight keeps what it uses alive
+// while another thread destroys the handle.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <unordered_map>
+#include <vector>
+
+#include "config.h"
+#include "dispatch.h"
+#include "grasp_session.h"
+#include "hand_synthesis.h"
+#include "xr_includes.h"
+
+namespace sdfg::layer {
+
+inline constexpr const char* kLayerName = "XR_APILAYER_SDFG_autograsp";
+
+template <class H>
+uint64_t key(H handle) {
+  if constexpr (std::is_pointer_v<H>)
+    return reinterpret_cast<uint64_t>(handle);
+  else
+    return static_cast<uint64_t>(handle);
+}
+
+template <class H>
+H fromKey(uint64_t value) {
+  if constexpr (std::is_pointer_v<H>)
+    return reinterpret_cast<H>(value);
+  else
+    return static_cast<H>(value);
+}
+
+// Handles the layer makes itself (hand trackers it synthesizes, grasp targets): non-canonical
+// x86_64 addresses, so they never equal a runtime's pointer-valued handle.
+uint64_t newLayerHandle();
+
+// Paths of one interaction profile the layer binds its input on.
+struct ProfilePaths {
+  XrPath profile = XR_NULL_PATH;
+  XrPath squeeze[2] = {};
+  XrPath grip[2] = {};
+};
+
+struct InstanceState {
+  XrInstance handle = XR_NULL_HANDLE;
+  PFN_xrGetInstanceProcAddr nextGipa = nullptr;
+  NextDispatch next;
+  Config config;
+
+  // What the app enabled, and what the runtime offers.
+  bool appAutoGrasp = false;
+  bool appHandTracking = false;
+  bool appMotionRange = false;
+  bool appDebugUtils = false;
+  bool runtimeHandTracking = false;
+  bool runtimeMotionRange = false;
+  // The layer answers XR_EXT_hand_tracking itself (app enabled it, the runtime lacks it).
+  bool provideHandTracking = false;
+  // XR_EXT_hand_tracking is enabled on the runtime (the app's, or added for grasping).
+  bool downstreamHandTracking = false;
+  // The app enabled XR_EXT_hand_joints_motion_range but the runtime lacks it: stripped, and its
+  // struct unlinked from locate calls.
+  bool stripMotionRange = false;
+  // Any of the above: the layer intercepts. Otherwise it hands out the next layer's functions
+  // and the app runs exactly as without it.
+  bool active = false;
+
+  // The layer's own input (squeeze value and grip pose per hand), merged into the app's.
+  XrActionSet actionSet = XR_NULL_HANDLE;
+  XrAction squeezeAction = XR_NULL_HANDLE;
+  XrAction gripAction = XR_NULL_HANDLE;
+  std::array<XrPath, 2> handPaths{};
+  std::vector<ProfilePaths> profiles;     // resolved when the actions are created
+  std::mutex inputMutex;                  // guards the fields below
+  std::set<XrPath> appSuggestedProfiles;  // profiles the app suggested bindings for
+};
+
+struct TargetState;
+
+struct SessionState {
+  XrSession handle = XR_NULL_HANDLE;
+  std::shared_ptr<InstanceState> instance;
+  bool vulkan = false;  // created with a Vulkan binding
+  XrGraphicsBindingVulkanKHR vulkanBinding{};
+
+  std::mutex mutex;           // guards everything below
+  std::set<uint64_t> spaces;  // reference and action spaces the app created on this session
+  bool attached = false;      // the layer's action set is attached with the app's
+  std::array<XrSpace, 2> gripSpaces{};
+  XrSpace localSpace = XR_NULL_HANDLE;
+  XrTime predictedTime = 0;  // from the last xrWaitFrame
+  std::array<float, 2> squeeze{};
+  std::array<XrHandTrackerEXT, 2> internalTrackers{};  // the layer's own, on the runtime
+  std::unique_ptr<GraspSession> grasp;
+  GraspSettings settings;
+  std::unordered_map<uint64_t, std::shared_ptr<TargetState>> targets;
+};
+
+struct TrackerState {
+  uint64_t handle = 0;  // what the app holds
+  std::weak_ptr<SessionState> session;
+  Hand hand = Hand::left;
+  XrHandTrackerEXT runtimeHandle = XR_NULL_HANDLE;  // null: synthesized by the layer
+};
+
+struct TargetState {
+  uint64_t handle = 0;
+  std::weak_ptr<SessionState> session;
+  XrSpace space = XR_NULL_HANDLE;
+  XrPosef pose{};
+  uint32_t vertexCount = 0;
+};
+
+template <class T>
+class HandleMap {
+ public:
+  void insert(uint64_t handle, std::shared_ptr<T> value) {
+    std::lock_guard lock(mutex_);
+    map_[handle] = std::move(value);
+  }
+  std::shared_ptr<T> find(uint64_t handle) const {
+    std::lock_guard lock(mutex_);
+    auto it = map_.find(handle);
+    return it == map_.end() ? nullptr : it->second;
+  }
+  std::shared_ptr<T> erase(uint64_t handle) {
+    std::lock_guard lock(mutex_);
+    auto it = map_.find(handle);
+    if (it == map_.end()) return nullptr;
+    auto value = std::move(it->second);
+    map_.erase(it);
+    return value;
+  }
+  // Any entry (the 1.0.20 loader allows one instance at a time).
+  std::shared_ptr<T> any() const {
+    std::lock_guard lock(mutex_);
+    return map_.empty() ? nullptr : map_.begin()->second;
+  }
+  template <class Pred>
+  void eraseIf(Pred pred) {
+    std::lock_guard lock(mutex_);
+    std::erase_if(map_, [&](const auto& kv) { return pred(*kv.second); });
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::unordered_map<uint64_t, std::shared_ptr<T>> map_;
+};
+
+HandleMap<InstanceState>& instances();
+HandleMap<SessionState>& sessions();
+HandleMap<TrackerState>& trackers();
+HandleMap<TargetState>& targets();
+// Space -> owning session, for spaces the app created through this layer.
+HandleMap<SessionState>& spaceOwners();
+
+// Maps a core Status to the XrResult the extension returns.
+XrResult toXrResult(Status status);
+
+// Pose conversions between OpenXR and the core.
+Pose toPose(const XrPosef& p);
+XrPosef toXr(const Pose& p);
+bool isUnitQuaternion(const XrQuaternionf& q);
+bool isFinitePose(const XrPosef& p);
+
+// Finds a struct of `type` in a `next` chain.
+template <class T, class Base>
+T* findInChain(Base* chain, XrStructureType type) {
+  for (auto* p = reinterpret_cast<XrBaseOutStructure*>(
+           const_cast<void*>(static_cast<const void*>(chain)));
+       p != nullptr; p = p->next) {
+    if (p->type == type) return reinterpret_cast<T*>(p);
+  }
+  return nullptr;
+}
+
+// Grasp settings from the config (solver name resolved: "default" -> "ours" when built in,
+// else "paper").
+GraspSettings settingsFromConfig(const Config& config);
+std::string resolveSolverName(const std::string& name);
+
+// Runs the layer's grab update for both hands after the app's xrSyncActions.
+void updateGrasps(SessionState& session);
+
+}  // namespace sdfg::layer
+
+// The catch-all every entry point wraps its body in: no exception crosses the C ABI.
+#define SDFG_ENTRY_BEGIN try {
+#define SDFG_ENTRY_END(cmd)                                                             \
+  }                                                                                     \
+  catch (const std::bad_alloc&) {                                                       \
+    return ::sdfg::layer::logError(XR_ERROR_OUT_OF_MEMORY, cmd, "out of memory");       \
+  }                                                                                     \
+  catch (const std::exception& e) {                                                     \
+    return ::sdfg::layer::logError(XR_ERROR_RUNTIME_FAILURE, cmd, "%s", e.what());      \
+  }                                                                                     \
+  catch (...) {                                                                         \
+    return ::sdfg::layer::logError(XR_ERROR_RUNTIME_FAILURE, cmd, "unknown exception"); \
+  }

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Checks the built layer library: its only exported symbol is xrNegotiateLoaderApiLayerInterface,
+# it does not link the OpenXR loader, and its file name follows the Khronos pattern.
+set -euo pipefail
+lib="$1"
+fail=0
+case "$(basename "$lib")" in
+  libXrApiLayer_*.so) ;;
+  *) echo "FAIL: library name $(basename "$lib") is not libXrApiLayer_<name>.so"; fail=1 ;;
+esac
+exported=$(nm -D --defined-only "$lib" | awk '$2 ~ /^[TtDdBbRrVvWwiu]$/ { print $3 }' | sort -u)
+echo "exported: $exported"
+if [ "$exported" != "xrNegotiateLoaderApiLayerInterface" ]; then
+  echo "FAIL: the library must export exactly xrNegotiateLoaderApiLayerInterface"; fail=1
+fi
+needed=$(objdump -p "$lib" | awk '$1 == "NEEDED" { print $2 }')
+echo "needed: $(echo $needed)"
+if echo "$needed" | grep -q openxr_loader; then
+  echo "FAIL: the layer links the OpenXR loader"; fail=1
+fi
+# No undefined xr* symbol either: the layer reaches OpenXR only through the chain.
+if nm -D --undefined-only "$lib" | awk '{ print $2 }' | grep -q '^xr'; then
+  echo "FAIL: the layer imports xr* symbols"; fail=1
+fi
+[ "$fail" = 0 ] && echo PASS
+exit "$fail"

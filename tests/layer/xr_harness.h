@@ -1,0 +1,92 @@
+// Test harness of the layer tests: an OpenXR app that goes through the real Khronos loader, the
+// layer under test (implicit, from the build tree), the Khronos core validation layer and the
+// mock runtime, with the environment each test needs. Every App checks at teardown that core
+// validation logged nothing.
+#pragma once
+
+#include <time.h>
+#include <vulkan/vulkan.h>
+#define XR_USE_GRAPHICS_API_VULKAN
+#define XR_USE_TIMESPEC
+#include <openxr/openxr.h>
+#include <openxr/openxr_platform.h>
+
+#include <openxr/XR_SDFG_auto_grasp.h>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace sdfg::test {
+
+struct XrEnv {
+  bool layer = true;               // false: the layer's disable_environment variable is set
+  std::string handTracking = "1";  // SDFG_MOCK_HAND_TRACKING: "1", "0" or "absent"
+  std::string script;              // mock runtime timeline (empty: none)
+  std::vector<std::pair<std::string, std::string>> extra;  // more variables
+};
+
+// Sets the process environment for the next instance; returns the core-validation log path.
+std::string applyEnv(const XrEnv& env);
+// Text the core validation layer logged so far (empty when it logged nothing).
+std::string validationLog();
+
+struct AppOptions {
+  std::vector<std::string> extensions;  // besides XR_MND_headless, always enabled
+  bool appActions = true;               // suggest, attach and sync an app action set
+};
+
+class App {
+ public:
+  explicit App(const AppOptions& options);
+  ~App();
+  App(const App&) = delete;
+  App& operator=(const App&) = delete;
+
+  bool ok() const { return ok_; }
+  XrInstance instance = XR_NULL_HANDLE;
+  XrSystemId system = XR_NULL_SYSTEM_ID;
+  XrSession session = XR_NULL_HANDLE;
+  XrSpace local = XR_NULL_HANDLE;
+  XrActionSet appSet = XR_NULL_HANDLE;
+  XrAction appSqueeze = XR_NULL_HANDLE;
+  std::array<XrPath, 2> hands{};
+  XrTime lastTime = 0;
+  uint64_t framesEnded = 0;
+  XrResult lastSync = XR_SUCCESS;
+
+  template <class F>
+  F fn(const char* name) const {
+    PFN_xrVoidFunction f = nullptr;
+    if (xrGetInstanceProcAddr(instance, name, &f) != XR_SUCCESS) return nullptr;
+    return reinterpret_cast<F>(f);
+  }
+
+  // One frame: events, wait, begin, sync actions, end.
+  void frame();
+  void frames(int n) {
+    for (int i = 0; i < n; ++i) frame();
+  }
+  // The app's own squeeze action state for a hand (to check the layer leaves it alone).
+  float appSqueezeValue(int hand) const;
+  void destroySession();
+
+ private:
+  void pollEvents();
+  bool ok_ = false;
+  bool running_ = false;
+};
+
+// XR_EXT_hand_tracking helpers.
+struct Joints {
+  XrHandJointLocationsEXT locations{XR_TYPE_HAND_JOINT_LOCATIONS_EXT};
+  std::array<XrHandJointLocationEXT, XR_HAND_JOINT_COUNT_EXT> joints{};
+};
+XrResult locateJoints(const App& app, XrHandTrackerEXT tracker, Joints& out,
+                      const void* locateNext = nullptr);
+
+// Script lines for a controller: grip pose and squeeze value at a frame.
+std::string gripLine(uint64_t frame, const char* hand, const XrPosef& pose);
+std::string squeezeLine(uint64_t frame, const char* hand, float value);
+
+}  // namespace sdfg::test

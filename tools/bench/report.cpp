@@ -1,0 +1,954 @@
+#include "report.h"
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <thread>
+#include <variant>
+
+#include "evaluator.h"
+#include "hand_model.h"
+#include "mesh_io.h"
+#include "placements.h"
+#include "sdf_cpu.h"
+#include "shapes.h"
+
+namespace fs = std::filesystem;
+
+namespace sdfg::bench {
+namespace {
+
+constexpr float kHandSizeDiagonal = 0.18f;  // as the bench: every object scaled to this diagonal
+constexpr uint64_t kScalingSeed = 1;
+
+// ---------------------------------------------------------------------------------------------
+// A small JSON reader: enough for the bench's own output (objects, arrays, strings, numbers,
+// true/false/null). Object members keep their order, so columns come out as the bench wrote them.
+
+struct Json {
+  using Object = std::vector<std::pair<std::string, Json>>;
+  using Array = std::vector<Json>;
+  std::variant<std::nullptr_t, bool, double, std::string, Array, Object> v;
+
+  bool isNumber() const { return std::holds_alternative<double>(v); }
+  bool isNull() const { return std::holds_alternative<std::nullptr_t>(v); }
+  const Object* object() const { return std::get_if<Object>(&v); }
+  const Array* array() const { return std::get_if<Array>(&v); }
+  const Json* find(const std::string& key) const {
+    if (const Object* o = object()) {
+      for (const auto& [k, value] : *o) {
+        if (k == key) return &value;
+      }
+    }
+    return nullptr;
+  }
+  double number() const { return isNumber() ? std::get<double>(v) : std::nan(""); }
+  std::string string() const {
+    if (const auto* s = std::get_if<std::string>(&v)) return *s;
+    return {};
+  }
+};
+
+class JsonParser {
+ public:
+  explicit JsonParser(const std::string& text) : s_(text) {}
+
+  std::optional<Json> parse(std::string& error) {
+    Json out;
+    if (!value(out, 0) || (skip(), pos_ != s_.size())) {
+      error = error_.empty() ? "unexpected text at offset " + std::to_string(pos_) : error_;
+      return std::nullopt;
+    }
+    return out;
+  }
+
+ private:
+  void skip() {
+    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+  }
+  bool fail(const std::string& what) {
+    if (error_.empty()) error_ = what + " at offset " + std::to_string(pos_);
+    return false;
+  }
+  bool literal(const char* word) {
+    const size_t n = std::char_traits<char>::length(word);
+    if (s_.compare(pos_, n, word) != 0) return fail("bad literal");
+    pos_ += n;
+    return true;
+  }
+  bool str(std::string& out) {
+    ++pos_;  // opening quote
+    while (pos_ < s_.size() && s_[pos_] != '"') {
+      char c = s_[pos_++];
+      if (c == '\\') {
+        if (pos_ >= s_.size()) return fail("unterminated escape");
+        const char e = s_[pos_++];
+        switch (e) {
+          case 'n':
+            c = '\n';
+            break;
+          case 't':
+            c = '\t';
+            break;
+          case 'r':
+            c = '\r';
+            break;
+          case 'b':
+            c = '\b';
+            break;
+          case 'f':
+            c = '\f';
+            break;
+          case 'u': {
+            if (pos_ + 4 > s_.size()) return fail("short \\u escape");
+            const unsigned code = unsigned(std::strtoul(s_.substr(pos_, 4).c_str(), nullptr, 16));
+            pos_ += 4;
+            c = code < 0x80 ? char(code) : '?';  // the bench writes only control characters so
+            break;
+          }
+          default:
+            c = e;
+        }
+      }
+      out += c;
+    }
+    if (pos_ >= s_.size()) return fail("unterminated string");
+    ++pos_;
+    return true;
+  }
+  bool value(Json& out, int depth) {
+    if (depth > 64) return fail("nesting too deep");
+    skip();
+    if (pos_ >= s_.size()) return fail("unexpected end");
+    const char c = s_[pos_];
+    if (c == '{') {
+      ++pos_;
+      Json::Object members;
+      skip();
+      if (pos_ < s_.size() && s_[pos_] == '}') {
+        ++pos_;
+      } else {
+        for (;;) {
+          skip();
+          if (pos_ >= s_.size() || s_[pos_] != '"') return fail("expected a member name");
+          std::string key;
+          if (!str(key)) return false;
+          skip();
+          if (pos_ >= s_.size() || s_[pos_] != ':') return fail("expected ':'");
+          ++pos_;
+          Json member;
+          if (!value(member, depth + 1)) return false;
+          members.emplace_back(std::move(key), std::move(member));
+          skip();
+          if (pos_ < s_.size() && s_[pos_] == ',') {
+            ++pos_;
+          } else if (pos_ < s_.size() && s_[pos_] == '}') {
+            ++pos_;
+            break;
+          } else {
+            return fail("expected ',' or '}'");
+          }
+        }
+      }
+      out.v = std::move(members);
+      return true;
+    }
+    if (c == '[') {
+      ++pos_;
+      Json::Array items;
+      skip();
+      if (pos_ < s_.size() && s_[pos_] == ']') {
+        ++pos_;
+      } else {
+        for (;;) {
+          Json item;
+          if (!value(item, depth + 1)) return false;
+          items.push_back(std::move(item));
+          skip();
+          if (pos_ < s_.size() && s_[pos_] == ',') {
+            ++pos_;
+          } else if (pos_ < s_.size() && s_[pos_] == ']') {
+            ++pos_;
+            break;
+          } else {
+            return fail("expected ',' or ']'");
+          }
+        }
+      }
+      out.v = std::move(items);
+      return true;
+    }
+    if (c == '"') {
+      std::string text;
+      if (!str(text)) return false;
+      out.v = std::move(text);
+      return true;
+    }
+    if (c == 'n') return literal("null") && (out.v = nullptr, true);
+    if (c == 't') return literal("true") && (out.v = true, true);
+    if (c == 'f') return literal("false") && (out.v = false, true);
+    char* end = nullptr;
+    const double d = std::strtod(s_.c_str() + pos_, &end);
+    if (end == s_.c_str() + pos_) return fail("unexpected character");
+    pos_ = size_t(end - s_.c_str());
+    out.v = d;
+    return true;
+  }
+
+  const std::string& s_;
+  size_t pos_ = 0;
+  std::string error_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Formatting
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Three significant digits, but whole numbers from 1000 up (no "1.1e+04" in a table).
+std::string fmt(double v) {
+  if (!std::isfinite(v)) return "-";
+  char buf[48];
+  if (std::fabs(v) >= 1000.0) {
+    std::snprintf(buf, sizeof buf, "%.0f", v);
+  } else {
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+  }
+  return buf;
+}
+
+std::string withThousands(size_t n) {
+  std::string digits = std::to_string(n), out;
+  for (size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
+    out += digits[i];
+  }
+  return out;
+}
+
+// Numbers for gnuplot's data files: NaN marks a missing value (set datafile missing "NaN").
+std::string datNumber(double v) {
+  if (!std::isfinite(v)) return "NaN";
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::string datString(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) out += c == '"' ? '\'' : c;
+  return out + "\"";
+}
+
+std::string gpString(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) {
+    if (c == '\'')
+      out += "''";
+    else
+      out += c;
+  }
+  return out + "'";
+}
+
+std::string shellQuote(const std::string& s) {
+  if (!s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                        "0123456789_-./=,:+@%") == std::string::npos) {
+    return s;
+  }
+  std::string out = "'";
+  for (char c : s) {
+    if (c == '\'')
+      out += "'\\''";
+    else
+      out += c;
+  }
+  return out + "'";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scaling sweep
+
+class CpuScalingBuilder final : public ScalingBuilder {
+ public:
+  explicit CpuScalingBuilder(unsigned threads) : builder_(threads) {}
+  std::string name() const override { return "CPU"; }
+  Status prepare(const TriangleMesh&, const MeshDistance& distance) override {
+    distance_ = &distance;
+    return Status::ok;
+  }
+  Status build(const Pose& objectFromHand, const GridBox& box, SdfGrid& out) override {
+    if (!distance_) return Status::invalid_argument;
+    return builder_.build(*distance_, objectFromHand, box, out);
+  }
+
+ private:
+  CpuSdfBuilder builder_;
+  const MeshDistance* distance_ = nullptr;
+};
+
+struct SweepMesh {
+  std::string name;
+  std::optional<fs::path> path;  // else `mesh` holds it
+  TriangleMesh mesh;
+};
+
+// Loads (when needed), scales, builds the distance structure and seeded placements, then times
+// every builder at every resolution in `resolutions`. One point per resolution.
+Result<std::vector<ScalingPoint>> measureMesh(
+    const SweepMesh& source, const std::vector<int>& resolutions, const ScalingOptions& options,
+    const std::vector<std::unique_ptr<ScalingBuilder>>& builders) {
+  TriangleMesh loaded;
+  const TriangleMesh* original = &source.mesh;
+  if (source.path) {
+    auto result = loadMesh(*source.path);
+    if (!result) return result.error();
+    loaded = std::move(result->mesh);
+    original = &loaded;
+  }
+  if (auto error = validateMesh(original->positions, original->indices)) {
+    return makeError(error->code, source.name + ": " + error->message);
+  }
+  const TriangleMesh mesh = normalizedToDiagonal(*original, kHandSizeDiagonal);
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  auto distance = MeshDistance::create(mesh);
+  if (!distance) return distance.error();
+  const double prepareMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  auto exact = ExactMeshQuery::create(mesh);
+  if (!exact) return exact.error();
+
+  const HandModel hand = HandModel::defaultAdult(Hand::right);
+  GridBox box = GridBox::referenceDefault();
+  const std::vector<Placement> placements =
+      generatePlacements(mesh, **exact, hand, box, options.repeats, kScalingSeed);
+  if (placements.empty()) {
+    return makeError(Status::invalid_argument, source.name + ": no placement found room");
+  }
+
+  std::vector<ScalingPoint> points;
+  for (int resolution : resolutions) {
+    box.resolution = glm::uvec3(uint32_t(resolution));
+    ScalingPoint point{source.name, mesh.triangleCount(), resolution, prepareMs, {}};
+    for (const auto& builder : builders) {
+      if (Status s = builder->prepare(mesh, **distance); s != Status::ok) {
+        return makeError(s, builder->name() + ": prepare failed on " + source.name);
+      }
+      SdfGrid grid(box);
+      // One untimed build first: first-touch of the grid and the builder's caches.
+      if (Status s = builder->build(placements[0].objectFromHand, box, grid); s != Status::ok) {
+        return makeError(s, builder->name() + ": build failed on " + source.name);
+      }
+      std::vector<double> ms;
+      for (const Placement& p : placements) {
+        const auto b0 = Clock::now();
+        const Status s = builder->build(p.objectFromHand, box, grid);
+        ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - b0).count());
+        if (s != Status::ok) {
+          return makeError(s, builder->name() + ": build failed on " + source.name);
+        }
+      }
+      point.buildMs.push_back(median(ms));
+    }
+    std::fprintf(stderr, "scaling: %s, %zu triangles, %d^3: %s ms (%s)\n", source.name.c_str(),
+                 point.triangles, resolution, fmt(point.buildMs.front()).c_str(),
+                 builders.front()->name().c_str());
+    points.push_back(std::move(point));
+  }
+  return points;
+}
+
+}  // namespace
+
+std::vector<std::unique_ptr<ScalingBuilder>> makeScalingBuilders(unsigned threads) {
+  std::vector<std::unique_ptr<ScalingBuilder>> out;
+  out.push_back(std::make_unique<CpuScalingBuilder>(threads));
+  return out;
+}
+
+Result<ScalingResults> runScaling(const ScalingOptions& options) {
+  const auto builders = makeScalingBuilders(options.threads);
+  ScalingResults results;
+  results.repeats = options.repeats;
+  for (const auto& b : builders) results.builders.push_back(b->name());
+
+  auto sphere = [](int subdivisions) {
+    TriangleMesh m = makeSphere(0.05f, subdivisions);
+    return SweepMesh{"sphere-" + std::to_string(m.triangleCount()), std::nullopt, std::move(m)};
+  };
+  std::vector<SweepMesh> byTriangles;
+  SweepMesh byResolution;
+  std::vector<int> resolutions;
+  if (options.quick) {
+    for (int s : {2, 3, 4}) byTriangles.push_back(sphere(s));
+    byResolution = sphere(3);
+    resolutions = {8, 12, 16};
+  } else {
+    // The shared meshes span 4.6k..400k triangles; spheres fill the ends (and stand in for all
+    // of them when the folder is absent).
+    const char* files[] = {"torus.obj",
+                           "newell-teapot.obj",
+                           "stanford-bunny.obj",
+                           "stanford-armadillo-100k.obj",
+                           "stanford-dragon-100k.ply",
+                           "igea-268k.obj",
+                           "stanford-armadillo-400k-subdiv.obj"};
+    byTriangles.push_back(sphere(3));
+    bool haveBunny = false;
+    if (options.sharedMeshes) {
+      for (const char* f : files) {
+        const fs::path path = *options.sharedMeshes / f;
+        std::error_code ec;
+        if (!fs::is_regular_file(path, ec)) continue;
+        byTriangles.push_back({path.stem().string(), path, {}});
+        haveBunny = haveBunny || path.stem() == "stanford-bunny";
+      }
+    }
+    if (byTriangles.size() == 1) {
+      for (int s : {4, 5, 6, 7}) byTriangles.push_back(sphere(s));
+    }
+    if (haveBunny) {
+      byResolution = {"stanford-bunny", *options.sharedMeshes / "stanford-bunny.obj", {}};
+    } else {
+      byResolution = sphere(6);
+    }
+    resolutions = {16, 24, 32, 48, 64};
+  }
+
+  for (const SweepMesh& m : byTriangles) {
+    auto points = measureMesh(m, {options.resolution}, options, builders);
+    if (!points) return points.error();
+    results.byTriangles.push_back(std::move(points->front()));
+  }
+  std::stable_sort(
+      results.byTriangles.begin(), results.byTriangles.end(),
+      [](const ScalingPoint& a, const ScalingPoint& b) { return a.triangles < b.triangles; });
+  auto points = measureMesh(byResolution, resolutions, options, builders);
+  if (!points) return points.error();
+  results.byResolution = std::move(*points);
+  return results;
+}
+
+namespace {
+
+// Markdown tables of the sweep; shared by the console and the report.
+std::string scalingTables(const ScalingResults& r, const std::string& level) {
+  std::ostringstream md;
+  auto header = [&](const std::string& first) {
+    md << "| " << first;
+    for (const auto& b : r.builders) md << " | " << b << " build (ms)";
+    for (size_t i = 1; i < r.builders.size(); ++i) {
+      md << " | " << r.builders.front() << " / " << r.builders[i];
+    }
+    md << " |\n|---|";
+    for (size_t i = 0; i < 2 * r.builders.size() - 1; ++i) md << "---:|";
+    md << "\n";
+  };
+  auto cells = [&](const ScalingPoint& p) {
+    for (double ms : p.buildMs) md << " | " << fmt(ms);
+    for (size_t i = 1; i < p.buildMs.size(); ++i) md << " | " << fmt(p.buildMs[0] / p.buildMs[i]);
+    md << " |\n";
+  };
+  if (!r.byTriangles.empty()) {
+    md << level << " SDF build time against triangle count\n\n"
+       << "Grab box " << r.byTriangles.front().resolution << "^3, median of " << r.repeats
+       << " seeded placements per mesh (one untimed build first). Set-up = `MeshDistance` "
+          "(BVH) build, once per mesh.\n\n";
+    md << "| mesh | triangles | set-up (ms)";
+    for (const auto& b : r.builders) md << " | " << b << " build (ms)";
+    for (size_t i = 1; i < r.builders.size(); ++i) {
+      md << " | " << r.builders.front() << " / " << r.builders[i];
+    }
+    md << " |\n|---|---:|---:|";
+    for (size_t i = 0; i < 2 * r.builders.size() - 1; ++i) md << "---:|";
+    md << "\n";
+    for (const ScalingPoint& p : r.byTriangles) {
+      md << "| " << p.mesh << " | " << withThousands(p.triangles) << " | " << fmt(p.prepareMs);
+      cells(p);
+    }
+    md << "\n";
+  }
+  if (!r.byResolution.empty()) {
+    const ScalingPoint& first = r.byResolution.front();
+    md << level << " SDF build time against grid resolution\n\n"
+       << "Mesh " << first.mesh << " (" << withThousands(first.triangles)
+       << " triangles), median of " << r.repeats << " seeded placements per resolution.\n\n";
+    header("resolution");
+    for (const ScalingPoint& p : r.byResolution) {
+      md << "| " << p.resolution << "^3 ("
+         << withThousands(size_t(p.resolution) * p.resolution * p.resolution) << " nodes)";
+      cells(p);
+    }
+    md << "\n";
+  }
+  return md.str();
+}
+
+}  // namespace
+
+void printScaling(const ScalingResults& results) {
+  std::printf("\n%s", scalingTables(results, "###").c_str());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Report
+
+fs::path reportResultsPath(const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir / "bench-data", ec);
+  return dir / "bench-data" / "results.json";
+}
+
+std::string shellCommandLine(int argc, char** argv) {
+  std::string out;
+  for (int i = 0; i < argc; ++i) out += (i ? " " : "") + shellQuote(argv[i]);
+  return out;
+}
+
+namespace {
+
+struct Column {
+  std::string key;  // top-level member of a row
+  std::string sub;  // member of that object, or empty for a plain number
+  std::string title() const { return sub.empty() ? key : key + " " + sub; }
+  double get(const Json& row) const {
+    const Json* v = row.find(key);
+    if (v && !sub.empty()) v = v->find(sub);
+    return v ? v->number() : std::nan("");
+  }
+};
+
+struct Table {
+  std::vector<std::string> meshes, methods;
+  std::map<std::pair<std::string, std::string>, const Json*> rows;
+  const Json* at(const std::string& mesh, const std::string& method) const {
+    auto it = rows.find({mesh, method});
+    return it == rows.end() ? nullptr : it->second;
+  }
+};
+
+std::string firstLineOf(const char* file, const char* prefix) {
+  std::ifstream in(file);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind(prefix, 0) == 0) {
+      const size_t colon = line.find(':');
+      std::string v = colon == std::string::npos ? line : line.substr(colon + 1);
+      v.erase(0, v.find_first_not_of(" \t"));
+      return v;
+    }
+  }
+  return {};
+}
+
+std::string nowUtc() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[64];
+  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M UTC", &tm);
+  return buf;
+}
+
+bool writeFile(const fs::path& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  out.flush();
+  return bool(out);
+}
+
+const char* kPlotStyle =
+    "set terminal pngcairo size 1000,520 noenhanced font 'sans,10'\n"
+    "set datafile missing 'NaN'\n"
+    "set grid ytics lc rgb '#dddddd'\n"
+    "set border 3\nset tics nomirror\n";
+
+// A clustered bar chart: one cluster per mesh, one bar per method.
+std::string barPlot(const std::string& dat, const std::string& png, const std::string& title,
+                    const std::string& ylabel, size_t methods, bool logY) {
+  std::ostringstream gp;
+  gp << kPlotStyle << "set output " << gpString(png) << "\n"
+     << "set title " << gpString(title) << "\nset ylabel " << gpString(ylabel) << "\n"
+     << "set style data histograms\nset style histogram clustered gap 1\n"
+     << "set style fill solid 0.85 border -1\nset boxwidth 0.9\n"
+     << "set key outside right top\nset xtics rotate by -25\n"
+     << (logY ? "set logscale y\n" : "set yrange [0:*]\n") << "plot for [i=2:" << methods + 1
+     << "] " << gpString(dat) << " using i:xtic(1) title columnheader(i)\n";
+  return gp.str();
+}
+
+std::string linePlot(const std::string& dat, const std::string& png, const std::string& title,
+                     const std::string& xlabel, const std::vector<std::string>& builders, bool logX,
+                     bool labels, const std::string& extra = {}) {
+  std::ostringstream gp;
+  gp << kPlotStyle << extra << "set output " << gpString(png) << "\n"
+     << "set title " << gpString(title) << "\nset xlabel " << gpString(xlabel) << "\n"
+     << "set ylabel 'build time per grab (ms)'\nset logscale y\n"
+     << (logX ? "set logscale x\nset format x '%.0s%c'\n" : "") << "set key left top\n"
+     << "set grid xtics lc rgb '#dddddd'\n"
+     << "plot ";
+  for (size_t i = 0; i < builders.size(); ++i) {
+    gp << (i ? ", " : "") << gpString(dat) << " using 2:" << 3 + i
+       << " with linespoints lw 2 pt 7 title " << gpString(builders[i]);
+  }
+  if (labels) {
+    // Names alternate above and below their points: meshes of equal size (100k) stay legible.
+    gp << ", " << gpString(dat)
+       << " using 2:(int($0) % 2 == 0 ? $3 : NaN):1 with labels offset 0,1 font 'sans,8' notitle"
+       << ", " << gpString(dat)
+       << " using 2:(int($0) % 2 == 1 ? $3 : NaN):1 with labels offset 0,-1 font 'sans,8' notitle";
+  }
+  gp << "\n";
+  return gp.str();
+}
+
+}  // namespace
+
+std::optional<Error> writeReport(const ReportRequest& request, const ScalingResults* scaling) {
+  std::ifstream in(request.resultsJson);
+  if (!in) {
+    return makeError(Status::io_error, request.resultsJson.string() + ": cannot read");
+  }
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+  std::string parseError;
+  const std::optional<Json> json = JsonParser(text).parse(parseError);
+  if (!json) {
+    return makeError(Status::io_error, request.resultsJson.string() + ": " + parseError);
+  }
+  const Json* rowsJson = json->find("rows");
+  if (!rowsJson || !rowsJson->array()) {
+    return makeError(Status::io_error, request.resultsJson.string() + ": no \"rows\" array");
+  }
+
+  const fs::path imgDir = request.dir / "img" / "bench";
+  const fs::path dataDir = request.dir / "bench-data";
+  std::error_code ec;
+  fs::create_directories(imgDir, ec);
+  fs::create_directories(dataDir, ec);
+  if (ec) return makeError(Status::io_error, request.dir.string() + ": " + ec.message());
+
+  // Rows by mesh and method, in the order the bench ran them; the quality columns are every
+  // member not shown elsewhere, in the JSON's order.
+  Table table;
+  std::vector<Column> quality;
+  const std::vector<std::string> identity = {"mesh",      "method",   "sdf_backend",
+                                             "triangles", "solve_us", "sdf_build_ms"};
+  for (const Json& row : *rowsJson->array()) {
+    std::string mesh = row.find("mesh") ? row.find("mesh")->string() : "";
+    const std::string method = row.find("method") ? row.find("method")->string() : "";
+    // Two meshes of one name (the embedded torus and torus.obj): the later one is "name (2)".
+    for (int n = 2; table.at(mesh, method); ++n) {
+      mesh = (row.find("mesh") ? row.find("mesh")->string() : "") + " (" + std::to_string(n) + ")";
+    }
+    if (std::find(table.meshes.begin(), table.meshes.end(), mesh) == table.meshes.end()) {
+      table.meshes.push_back(mesh);
+    }
+    if (std::find(table.methods.begin(), table.methods.end(), method) == table.methods.end()) {
+      table.methods.push_back(method);
+    }
+    table.rows[{mesh, method}] = &row;
+    if (const Json::Object* members = row.object()) {
+      for (const auto& [key, value] : *members) {
+        if (std::find(identity.begin(), identity.end(), key) != identity.end()) continue;
+        std::vector<Column> found;
+        if (const Json::Object* sub = value.object()) {
+          for (const auto& [subKey, subValue] : *sub) {
+            if (subValue.isNumber() || subValue.isNull()) found.push_back({key, subKey});
+          }
+        } else if (value.isNumber() || value.isNull()) {
+          found.push_back({key, ""});
+        }
+        for (const Column& c : found) {
+          const bool known = std::any_of(quality.begin(), quality.end(), [&](const Column& q) {
+            return q.key == c.key && q.sub == c.sub;
+          });
+          if (!known) quality.push_back(c);
+        }
+      }
+    }
+  }
+
+  // Every top-level number of the JSON (placements, seed, da, resolution...) as "key value".
+  std::string settings;
+  for (const auto& [key, value] : *json->object()) {
+    if (value.isNumber())
+      settings += (settings.empty() ? "" : ", ") + key + " " + fmt(value.number());
+  }
+  std::ostringstream md;
+  md << "# Benchmarks: `autograsp-bench`\n\n"
+     << "This file and the plots in `img/bench/` are written by `autograsp-bench --report` "
+        "from one run; edit the program (or `benchmarks-notes.md`, copied in at the end), not "
+        "this file. The command:\n\n```sh\n"
+     << request.commandLine << "\n```\n\n";
+  const std::string cpu = firstLineOf("/proc/cpuinfo", "model name");
+  std::string load;
+  {
+    std::ifstream loadavg("/proc/loadavg");
+    std::string a, b, c;
+    if (loadavg >> a >> b >> c) load = a + ", " + b + ", " + c;
+  }
+  md << "| | |\n|---|---|\n"
+     << "| date | " << nowUtc() << " |\n"
+     << "| CPU | " << (cpu.empty() ? "unknown" : cpu) << " |\n"
+     << "| hardware threads (nproc) | " << std::thread::hardware_concurrency() << " |\n"
+     << "| threads used (SDF builds, grading) | " << request.threads << " |\n"
+     << "| load average at the end (1, 5, 15 min) | " << (load.empty() ? "unknown" : load) << " |\n"
+     << "| compiler | " <<
+#ifdef __VERSION__
+      __VERSION__
+#else
+      "unknown"
+#endif
+     << " |\n"
+     << "| run settings | " << settings << " |\n\n"
+     << "Times are wall-clock and depend on the machine and on what else ran on it; the load "
+        "average above says how busy it was.\n\n";
+
+  // Written-by-hand text survives regeneration: it lives in its own file, copied in at the end;
+  // when it is there it holds the definitions, else a short version goes here.
+  std::string notes;
+  if (std::ifstream notesIn{request.dir / "benchmarks-notes.md"}) {
+    std::stringstream text;
+    text << notesIn.rdbuf();
+    notes = text.str();
+  }
+  if (!notes.empty()) {
+    md << "How to run it and what each figure means: at the end of this page. `-` in a table: no "
+          "data (no finger in contact, no field for a physics method).\n\n";
+  } else {
+    md << "## What is measured\n\n"
+       << "Every mesh is scaled to an 18 cm bounding-box diagonal (hand size). Seeded hand "
+          "placements (`src/placements.h`) put the open palm 1 to 4 cm from a random surface "
+          "point; every method solves the same placements. `solve_us`: per-solve time, minimum "
+          "over repeated batches, SDF build not included (as in the paper's Table 1). "
+          "`sdf_build_ms`: the CPU grab-box SDF build per placement, for the methods that read a "
+          "field. Quality is graded against CGAL's exact distance to the original surface "
+          "(`src/evaluator.h`): `tip_residual_mm` |d(tip) - r_tip| over fingers in contact; "
+          "`penetration_mm` deepest phalanx point inside the mesh per grasp; `early_stops` "
+          "fingers (summed over grasps) that stopped more than 5 mm short of a reachable pose; "
+          "`contacts_mean` fingers within 2 mm per grasp. Any other column is a metric of the "
+          "JSON documented in `src/evaluator.h`. `-`: no data (e.g. no finger in contact, no "
+          "field for a physics method).\n\n";
+  }
+
+  // Speed table: the paper's Table 1 layout.
+  md << "## Speed\n\nSolve time per grasp, median, microseconds (the paper's Table 1 reports 0.01 "
+        "to 0.03 ms for its SDF method and 0.04 to 0.1 ms for physics, Unity on an Apple M1):\n\n"
+     << "| method |";
+  for (const auto& m : table.meshes) md << " " << m << " |";
+  md << "\n|---|";
+  for (size_t i = 0; i < table.meshes.size(); ++i) md << "---:|";
+  md << "\n";
+  const Column solve{"solve_us", "median"}, build{"sdf_build_ms", "median"};
+  for (const auto& method : table.methods) {
+    md << "| " << method << " |";
+    for (const auto& mesh : table.meshes) {
+      const Json* r = table.at(mesh, method);
+      md << " " << (r ? fmt(solve.get(*r)) : "-") << " |";
+    }
+    md << "\n";
+  }
+  md << "| CPU SDF build (ms) |";
+  for (const auto& mesh : table.meshes) {
+    double ms = std::nan("");
+    for (const auto& method : table.methods) {
+      const Json* r = table.at(mesh, method);
+      if (r && std::isfinite(build.get(*r))) {
+        ms = build.get(*r);
+        break;
+      }
+    }
+    md << " " << fmt(ms) << " |";
+  }
+  md << "\n| triangles |";
+  for (const auto& mesh : table.meshes) {
+    const Json* r = table.at(mesh, table.methods.front());
+    const Json* t = r ? r->find("triangles") : nullptr;
+    md << " " << (t && t->isNumber() ? withThousands(size_t(t->number())) : "-") << " |";
+  }
+  md << "\n\n![solve time](img/bench/solve_time.png)\n\n";
+
+  md << "## Quality\n\nAgainst the exact mesh; millimetres unless the name says otherwise.\n\n"
+     << "| mesh | method |";
+  for (const Column& c : quality) md << " " << c.title() << " |";
+  md << "\n|---|---|";
+  for (size_t i = 0; i < quality.size(); ++i) md << "---:|";
+  md << "\n";
+  for (const auto& mesh : table.meshes) {
+    for (const auto& method : table.methods) {
+      const Json* r = table.at(mesh, method);
+      if (!r) continue;
+      md << "| " << mesh << " | " << method << " |";
+      for (const Column& c : quality) md << " " << fmt(c.get(*r)) << " |";
+      md << "\n";
+    }
+  }
+  md << "\n";
+
+  // Plots of the bench rows: one data file per figure, meshes down, methods across.
+  struct BarFigure {
+    std::string file, title, ylabel;
+    Column column;
+    bool logY;
+  };
+  std::vector<BarFigure> bars = {{"solve_time",
+                                  "Solve time per grasp, median (SDF build not included)",
+                                  "microseconds (log scale)", solve, true}};
+  for (const Column& c : quality) {
+    // One figure per metric: its median / p99 (the figure that summarises it), or the number.
+    if (c.key == "grasps") continue;
+    const bool primary =
+        c.sub.empty() || c.sub == "median" || (c.sub == "p99" && c.key == "penetration_mm");
+    if (!primary) continue;
+    bars.push_back({c.key, c.title() + " per method and mesh", c.title(), c, false});
+  }
+  std::ostringstream gpAll;
+  for (const BarFigure& f : bars) {
+    std::ostringstream dat;
+    dat << "mesh";
+    for (const auto& method : table.methods) dat << " " << datString(method);
+    dat << "\n";
+    for (const auto& mesh : table.meshes) {
+      dat << datString(mesh);
+      for (const auto& method : table.methods) {
+        const Json* r = table.at(mesh, method);
+        dat << " " << datNumber(r ? f.column.get(*r) : std::nan(""));
+      }
+      dat << "\n";
+    }
+    const fs::path datPath = dataDir / (f.file + ".dat");
+    if (!writeFile(datPath, dat.str())) {
+      return makeError(Status::io_error, datPath.string() + ": cannot write");
+    }
+    gpAll << barPlot(f.file + ".dat", "../img/bench/" + f.file + ".png", f.title, f.ylabel,
+                     table.methods.size(), f.logY);
+    if (f.file != "solve_time") {
+      md << "![" << f.title << "](img/bench/" << f.file << ".png)\n\n";
+    }
+  }
+
+  if (scaling) {
+    const ScalingResults& s = *scaling;
+    md << "## SDF build scaling\n\n" << scalingTables(s, "###");
+    auto writeDat = [&](const std::vector<ScalingPoint>& points, const std::string& name,
+                        bool byTriangles) -> std::optional<Error> {
+      std::ostringstream dat;
+      dat << "# mesh x";
+      for (const auto& b : s.builders) dat << " " << datString(b);
+      dat << "\n";
+      for (const ScalingPoint& p : points) {
+        dat << datString(p.mesh) << " " << (byTriangles ? double(p.triangles) : p.resolution);
+        for (double ms : p.buildMs) dat << " " << datNumber(ms);
+        dat << "\n";
+      }
+      const fs::path path = dataDir / (name + ".dat");
+      if (!writeFile(path, dat.str())) {
+        return makeError(Status::io_error, path.string() + ": cannot write");
+      }
+      return std::nullopt;
+    };
+    // Log x axes: a margin keeps end points and labels off the border.
+    auto xrange = [](const std::vector<ScalingPoint>& points, bool byTriangles) {
+      double lo = 1e300, hi = 0.0;
+      for (const ScalingPoint& p : points) {
+        const double x = byTriangles ? double(p.triangles) : double(p.resolution);
+        lo = std::min(lo, x);
+        hi = std::max(hi, x);
+      }
+      // Labels are centred on their points: the right end needs more room than the left.
+      const double right = byTriangles ? 2.5 : 1.4;
+      return "set xrange [" + datNumber(lo / 1.4) + ":" + datNumber(hi * right) + "]\n";
+    };
+    if (auto e = writeDat(s.byTriangles, "sdf_build_triangles", true)) return e;
+    if (auto e = writeDat(s.byResolution, "sdf_build_resolution", false)) return e;
+    if (!s.byTriangles.empty()) {
+      gpAll << linePlot("sdf_build_triangles.dat", "../img/bench/sdf_build_triangles.png",
+                        "Grab-box SDF build time against triangle count (" +
+                            std::to_string(s.byTriangles.front().resolution) + "^3 nodes)",
+                        "triangles (log scale)", s.builders, true, true,
+                        xrange(s.byTriangles, true));
+      md << "![SDF build time against triangles](img/bench/sdf_build_triangles.png)\n\n";
+    }
+    if (!s.byResolution.empty()) {
+      std::string xtics = "set xtics (";
+      for (size_t i = 0; i < s.byResolution.size(); ++i) {
+        xtics += (i ? ", " : "") + std::to_string(s.byResolution[i].resolution);
+      }
+      xtics += ")\n" + xrange(s.byResolution, false);
+      gpAll << linePlot("sdf_build_resolution.dat", "../img/bench/sdf_build_resolution.png",
+                        "Grab-box SDF build time against resolution (" +
+                            s.byResolution.front().mesh + ", " +
+                            withThousands(s.byResolution.front().triangles) + " triangles)",
+                        "grid nodes per axis (log scale)", s.builders, true, false, xtics);
+      md << "![SDF build time against resolution](img/bench/sdf_build_resolution.png)\n\n";
+    }
+  }
+
+  // gnuplot: one script for every figure, run in bench-data/ (paths in it are relative, so the
+  // folder can be moved and replotted); "reset" between figures keeps their styles apart.
+  const fs::path script = dataDir / "plots.gp";
+  std::string gp = gpAll.str();
+  for (size_t at = gp.find("set terminal", 1); at != std::string::npos;
+       at = gp.find("set terminal", at + 20)) {
+    gp.insert(at, "reset\n");
+  }
+  if (!writeFile(script, gp))
+    return makeError(Status::io_error, script.string() + ": cannot write");
+  std::string plotNote;
+  if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
+    plotNote = "gnuplot not found (Debian: apt-get install gnuplot-nox); no plots drawn";
+  } else if (std::system(("cd " + shellQuote(dataDir.string()) + " && gnuplot plots.gp").c_str()) !=
+             0) {
+    plotNote = "gnuplot failed on " + script.string() + "; plots may be missing";
+  }
+  if (!plotNote.empty()) {
+    std::fprintf(stderr, "autograsp-bench: %s\n", plotNote.c_str());
+    md << "_Note: " << plotNote << "._\n\n";
+  }
+  md << "The data behind the plots: `bench-data/` (the bench's JSON, one `.dat` per figure and "
+        "the gnuplot script `plots.gp`).\n";
+  if (!notes.empty()) md << "\n<!-- from benchmarks-notes.md -->\n\n" << notes;
+
+  const fs::path mdPath = request.dir / "benchmarks.md";
+  if (!writeFile(mdPath, md.str())) {
+    return makeError(Status::io_error, mdPath.string() + ": cannot write");
+  }
+  std::fprintf(stderr, "autograsp-bench: report written to %s\n", mdPath.string().c_str());
+  return std::nullopt;
+}
+
+bool runReport(const ReportRequest& request) {
+  ScalingOptions options;
+  options.quick = request.scalingQuick;
+  options.resolution = request.resolution;
+  options.threads = request.threads;
+  options.sharedMeshes = request.sharedMeshes;
+  auto scaling = runScaling(options);
+  if (!scaling) {
+    std::fprintf(stderr, "autograsp-bench: scaling: %s\n", scaling.error().message.c_str());
+    return false;
+  }
+  printScaling(*scaling);
+  if (request.dir.empty()) return true;
+  if (auto error = writeReport(request, &*scaling)) {
+    std::fprintf(stderr, "autograsp-bench: report: %s\n", error->message.c_str());
+    return false;
+  }
+  return true;
+}
+
+}  // namespace sdfg::bench

@@ -1,0 +1,136 @@
+// autograsp-demo-check: checks what autograsp-demo wrote, for the demo test.
+//   autograsp-demo-check DIR WIDTH OBJECT...
+// Per object: <object>-grasp.png is (3 * WIDTH + 8) x WIDTH, each of its three panels holds many
+// colours, the object's blue-grey and the hand's skin tone, and the image has contact magenta;
+// <object>-sdf-slice.png is WIDTH x WIDTH with inside blue, outside red and the black surface.
+// report.md and report.html exist, show every picture, have 15 finger rows per object and no
+// non-finite number. Prints each failed check; exit status 1 when any failed.
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "png_io.h"
+
+namespace {
+
+int failures = 0;
+
+void check(bool ok, const std::string& what) {
+  if (!ok) {
+    std::printf("FAIL: %s\n", what.c_str());
+    ++failures;
+  } else {
+    std::printf("ok:   %s\n", what.c_str());
+  }
+}
+
+struct Counts {
+  std::set<uint32_t> colours;
+  size_t hand = 0, object = 0, magenta = 0, blue = 0, red = 0, black = 0, pixels = 0;
+};
+
+Counts count(const std::vector<uint8_t>& rgba, uint32_t width, uint32_t x0, uint32_t x1,
+             uint32_t height) {
+  Counts c;
+  for (uint32_t y = 0; y < height; ++y) {
+    for (uint32_t x = x0; x < x1; ++x) {
+      const uint8_t* p = &rgba[(size_t(y) * width + x) * 4];
+      const int r = p[0], g = p[1], b = p[2];
+      c.colours.insert(uint32_t(r) << 16 | uint32_t(g) << 8 | uint32_t(b));
+      ++c.pixels;
+      if (r > g + 15 && g > b + 15 && r > 90) ++c.hand;          // skin: r > g > b
+      if (b > r + 15 && b >= g && b > 60 && r > 40) ++c.object;  // blue-grey
+      if (r == 255 && g == 0 && b == 255) ++c.magenta;           // contacts
+      if (b > r + 40) ++c.blue;
+      if (r > b + 40) ++c.red;
+      if (r < 8 && g < 8 && b < 8) ++c.black;
+    }
+  }
+  return c;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+bool hasNonFinite(const std::string& text) {
+  std::string lower;
+  for (char ch : text) lower += char(std::tolower(static_cast<unsigned char>(ch)));
+  for (const char* bad : {"nan", "inf"}) {
+    for (size_t at = lower.find(bad); at != std::string::npos; at = lower.find(bad, at + 1)) {
+      // A whole word only ("infinite" or "information" in prose is fine).
+      const bool startOk = at == 0 || !std::isalpha(static_cast<unsigned char>(lower[at - 1]));
+      const size_t end = at + 3;
+      const bool endOk =
+          end >= lower.size() || !std::isalpha(static_cast<unsigned char>(lower[end]));
+      if (startOk && endOk) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 4) {
+    std::fprintf(stderr, "usage: autograsp-demo-check DIR WIDTH OBJECT...\n");
+    return 2;
+  }
+  const std::string dir = argv[1];
+  const uint32_t w = uint32_t(std::atoi(argv[2]));
+  std::vector<std::string> objects(argv + 3, argv + argc);
+  const std::string md = slurp(dir + "/report.md"), html = slurp(dir + "/report.html");
+  check(!md.empty(), "report.md present");
+  check(!html.empty() && html.find("</html>") != std::string::npos, "report.html present");
+  check(!hasNonFinite(md) && !hasNonFinite(html), "no nan or inf in the reports");
+  size_t rows = 0;
+  for (size_t at = md.find("\n| "); at != std::string::npos; at = md.find("\n| ", at + 1)) ++rows;
+  // One header row per object, then 5 fingers x 3 strategies.
+  check(rows == objects.size() * 16,
+        "report.md: 15 finger rows per object (" + std::to_string(rows) + " table rows)");
+  for (const auto& o : objects) {
+    for (const std::string& png : {o + "-grasp.png", o + "-sdf-slice.png"}) {
+      check(md.find("(" + png + ")") != std::string::npos, "report.md shows " + png);
+      check(html.find("src=\"" + png + "\"") != std::string::npos, "report.html shows " + png);
+    }
+    uint32_t pw = 0, ph = 0;
+    std::vector<uint8_t> rgba;
+    std::string error;
+    const bool read = sdfg::demo::readPng(dir + "/" + o + "-grasp.png", pw, ph, rgba, error);
+    check(read, o + "-grasp.png readable " + error);
+    if (read) {
+      check(pw == 3 * w + 8 && ph == w, o + "-grasp.png is " + std::to_string(3 * w + 8) + "x" +
+                                            std::to_string(w) + " (got " + std::to_string(pw) +
+                                            "x" + std::to_string(ph) + ")");
+      size_t magenta = 0;
+      for (uint32_t p = 0; p < 3 && pw == 3 * w + 8; ++p) {
+        const Counts c = count(rgba, pw, p * (w + 4), p * (w + 4) + w, ph);
+        const std::string name = o + " panel " + std::to_string(p);
+        check(c.colours.size() > 200, name + ": " + std::to_string(c.colours.size()) + " colours");
+        check(c.hand > c.pixels / 100, name + ": hand colour on " + std::to_string(c.hand) + " px");
+        check(c.object > c.pixels / 200,
+              name + ": object colour on " + std::to_string(c.object) + " px");
+        magenta += c.magenta;
+      }
+      check(magenta > 0, o + ": contact markers (" + std::to_string(magenta) + " px)");
+    }
+    const bool readSlice =
+        sdfg::demo::readPng(dir + "/" + o + "-sdf-slice.png", pw, ph, rgba, error);
+    check(readSlice, o + "-sdf-slice.png readable " + error);
+    if (readSlice) {
+      check(pw == w && ph == w, o + "-sdf-slice.png is " + std::to_string(w) + " square");
+      const Counts c = count(rgba, pw, 0, pw, ph);
+      check(c.blue > 0 && c.red > c.pixels / 4 && c.black > 0,
+            o + " slice: inside blue, outside red, black surface");
+    }
+  }
+  std::printf("%s: %d failed checks\n", failures == 0 ? "PASS" : "FAIL", failures);
+  return failures == 0 ? 0 : 1;
+}

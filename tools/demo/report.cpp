@@ -1,0 +1,176 @@
+#include "report.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+namespace sdfg::demo {
+namespace {
+
+const char* kFingers[5] = {"thumb", "index", "middle", "ring", "little"};
+
+// Non-finite numbers never reach the report: they print as a dash.
+std::string num(float v, int decimals) {
+  if (!std::isfinite(v)) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, double(v));
+  return buf;
+}
+
+std::string escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '&')
+      out += "&amp;";
+    else
+      out += c;
+  }
+  return out;
+}
+
+struct Row {
+  std::vector<std::string> cells;
+};
+
+std::vector<std::string> header() {
+  return {"strategy",
+          "finger",
+          "curl",
+          "contact",
+          "reported distance (mm)",
+          "tip gap (mm)",
+          "least clearance (mm)"};
+}
+
+std::vector<Row> rows(const ObjectResult& o) {
+  std::vector<Row> out;
+  for (const auto& s : o.strategies) {
+    if (!s.ok) {
+      out.push_back({{s.name, "-", "-", "-", "-", "-", "failed: " + s.error}});
+      continue;
+    }
+    for (int f = 0; f < 5; ++f) {
+      const FingerRow& r = s.fingers[f];
+      out.push_back(
+          {{s.name, kFingers[f], num(r.curl, 3), r.contact ? "yes" : "no",
+            r.contact ? num(r.reportedMm, 2) : "-", num(r.tipGapMm, 2), num(r.clearanceMm, 2)}});
+    }
+  }
+  return out;
+}
+
+std::string summaryLine(const StrategyResult& s) {
+  std::ostringstream line;
+  line << s.name << " (" << s.source << "): ";
+  if (!s.ok) {
+    line << "failed: " << s.error;
+    return line.str();
+  }
+  float worst = 1e9f;
+  for (const auto& f : s.fingers) worst = std::min(worst, f.clearanceMm);
+  line << s.contacts << " fingers in contact, deepest point " << num(-std::min(worst, 0.0f), 1)
+       << " mm inside";
+  if (s.source == "layer")
+    line << ", grasp after " << s.frames << " frames (" << num(float(s.milliseconds), 1) << " ms)";
+  else
+    line << ", solved in " << num(float(s.milliseconds), 3) << " ms";
+  return line.str();
+}
+
+const char* kExplain =
+    "Each picture shows the same hand placement solved by three strategies, left to right: "
+    "`physics-convex` (the physics-overlap method of commercial toolkits, fingertip spheres "
+    "against the object's convex hull in Bullet, solved in-process by the core with the hand "
+    "pose the layer used), `paper` (the paper's per-fingertip SDF sweep) and `ours` "
+    "(whole-finger, conservative advancement, refined stop), the last two through OpenXR: the "
+    "layer, the mock runtime's scripted controller, `xrLocateHandJointsEXT` and "
+    "`xrGetGraspStateSDFG`. Object blue-grey, hand as capsules of its joint radii, contacts "
+    "magenta (drawn on top). The slice is the grab-box SDF (built by the core's CPU builder at "
+    "64^3 for the picture) in the middle finger's plane (blue "
+    "inside, red outside, 1 cm isolines, surface black) with the `ours` hand in white.\n\n"
+    "Columns: curl 0 open .. 1 closed; contact: the finger stopped on the surface; reported "
+    "distance: what the strategy saw at its contact (SDF or Bullet); tip gap: exact distance "
+    "of the fingertip sphere to the mesh (negative: inside); least clearance: the same for the "
+    "whole finger (capsules of the joint radii), so a negative value is a finger through the "
+    "object.";
+
+}  // namespace
+
+bool writeReports(const std::string& dir, const std::vector<ObjectResult>& objects,
+                  const ReportInfo& info, std::string& error) {
+  std::ofstream md(dir + "/report.md");
+  std::ofstream html(dir + "/report.html");
+  if (!md || !html) {
+    error = dir + ": cannot write report.md / report.html";
+    return false;
+  }
+  md << "# SDF Autograsp demo\n\n" << kExplain << "\n\n";
+  md << "Runtime: " << info.runtime << "; Vulkan device: " << info.device << "; "
+     << info.environment << "; panel width " << info.width << " px.\n\n";
+  html << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>SDF Autograsp demo</title>"
+       << "<style>body{font-family:sans-serif;max-width:1600px;margin:auto;background:#fafafa}"
+       << "img{max-width:100%;border:1px solid #ccc}table{border-collapse:collapse;margin:8px 0}"
+       << "td,th{border:1px solid #bbb;padding:2px 8px;text-align:right}"
+       << "td:first-child,td:nth-child(2){text-align:left}.fail{color:#b00}</style></head><body>\n"
+       << "<h1>SDF Autograsp demo</h1>\n<p>" << escape(kExplain)
+       << "</p>\n<p>Runtime: " << escape(info.runtime) << "; Vulkan device: " << escape(info.device)
+       << "; " << escape(info.environment) << "; panel width " << info.width << " px.</p>\n";
+  if (!info.failures.empty()) {
+    md << "## Meshes skipped\n\n";
+    html << "<h2>Meshes skipped</h2><ul>\n";
+    for (const auto& f : info.failures) {
+      md << "- " << f << "\n";
+      html << "<li class=\"fail\">" << escape(f) << "</li>\n";
+    }
+    md << "\n";
+    html << "</ul>\n";
+  }
+  for (const auto& o : objects) {
+    md << "## " << o.name << "\n\n" << o.origin << ", " << o.triangles << " triangles.\n\n";
+    md << "![" << o.name << ": physics-convex, paper, ours](" << o.graspPng << ")\n\n";
+    md << "![" << o.name << ": grab-box SDF slice](" << o.slicePng << ")\n\n";
+    html << "<h2>" << escape(o.name) << "</h2>\n<p>" << escape(o.origin) << ", " << o.triangles
+         << " triangles.</p>\n<p><img src=\"" << o.graspPng << "\" alt=\"" << escape(o.name)
+         << ": physics-convex, paper, ours\"></p>\n<p><img src=\"" << o.slicePng
+         << "\" alt=\"grab-box SDF slice\" style=\"max-width:512px\"></p>\n<ul>\n";
+    for (const auto& s : o.strategies) {
+      md << "- " << summaryLine(s) << "\n";
+      html << "<li>" << escape(summaryLine(s)) << "</li>\n";
+    }
+    md << "\n|";
+    html << "</ul>\n<table><tr>";
+    for (const auto& h : header()) {
+      md << " " << h << " |";
+      html << "<th>" << escape(h) << "</th>";
+    }
+    md << "\n|";
+    html << "</tr>\n";
+    for (size_t i = 0; i < header().size(); ++i) md << (i < 2 ? "---|" : "---:|");
+    md << "\n";
+    for (const auto& r : rows(o)) {
+      md << "|";
+      html << "<tr>";
+      for (const auto& c : r.cells) {
+        md << " " << c << " |";
+        html << "<td>" << escape(c) << "</td>";
+      }
+      md << "\n";
+      html << "</tr>\n";
+    }
+    md << "\n";
+    html << "</table>\n";
+  }
+  html << "</body></html>\n";
+  if (!md || !html) {
+    error = dir + ": writing the report failed";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace sdfg::demo

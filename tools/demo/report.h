@@ -1,0 +1,49 @@
+// The demo's report: per object the grasp picture (physics-convex, paper, ours side by side),
+// the SDF slice, and per strategy and finger the numbers, as Markdown and as HTML.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace sdfg::demo {
+
+struct FingerRow {
+  float curl = 0.0f;
+  bool contact = false;
+  float reportedMm =
+      0.0f;               // distance the strategy reported at its contact (finite only on contact)
+  float tipGapMm = 0.0f;  // exact distance of the tip sphere to the surface (negative: inside)
+  float clearanceMm = 0.0f;  // least exact clearance of any part of the finger (negative: inside)
+};
+
+struct StrategyResult {
+  std::string name;    // physics-convex, paper, ours
+  std::string source;  // "layer" (through OpenXR) or "core" (in-process, same hand pose)
+  bool ok = false;
+  std::string error;
+  std::array<FingerRow, 5> fingers{};
+  int contacts = 0;
+  int frames = 0;           // frames from the squeeze to the reported grasp (layer)
+  double milliseconds = 0;  // that time, or the solve time (core)
+};
+
+struct ObjectResult {
+  std::string name;
+  std::string origin;  // "embedded" or the file
+  size_t triangles = 0;
+  std::string graspPng, slicePng;  // file names in the output folder
+  std::vector<StrategyResult> strategies;
+};
+
+struct ReportInfo {
+  std::string runtime, device, environment;
+  int width = 0;
+  std::vector<std::string> failures;  // meshes that could not be used, with the reason
+};
+
+// Writes report.md and report.html into `dir`. False with `error` on an I/O failure.
+bool writeReports(const std::string& dir, const std::vector<ObjectResult>& objects,
+                  const ReportInfo& info, std::string& error);
+
+}  // namespace sdfg::demo

@@ -3,8 +3,8 @@
 //
 //   autograsp-sdf-scaling [--meshes DIR] [--runs N] [--res 16,32,64] [--quick] [--profile]
 //
-// --wg sets the compute work-group size (default 64). --profile adds the Vulkan pass times (GPU
-// timestamps) of the last run to each row.
+// --only torus|meshes keeps one group of rows. --wg sets the compute work-group size (default 64).
+// --profile adds the Vulkan pass times (GPU timestamps) of the last run to each row.
 //
 // Objects: a procedural torus tessellated to 5k .. 400k triangles (the same surface at every
 // count), then the shared test meshes when DIR (default ../shared/meshes) has them, each scaled
@@ -116,7 +116,7 @@ struct Row {
 int main(int argc, char** argv) {
   std::filesystem::path meshDir = "../shared/meshes";
   int runs = 5;
-  bool quick = false, profile = false;
+  bool quick = false, profile = false, torusRows = true, meshRows = true;
   uint32_t workGroup = 64;
   std::vector<uint32_t> resolutions = {16, 32, 64};
   for (int i = 1; i < argc; ++i) {
@@ -127,6 +127,10 @@ int main(int argc, char** argv) {
       runs = std::max(1, std::atoi(argv[++i]));
     } else if (a == "--wg" && i + 1 < argc) {
       workGroup = uint32_t(std::max(1, std::atoi(argv[++i])));
+    } else if (a == "--only" && i + 1 < argc) {
+      const std::string which = argv[++i];
+      torusRows = which == "torus";
+      meshRows = which == "meshes";
     } else if (a == "--profile") {
       profile = true;
     } else if (a == "--quick") {
@@ -137,10 +141,10 @@ int main(int argc, char** argv) {
       std::string r;
       while (std::getline(s, r, ',')) resolutions.push_back(uint32_t(std::atoi(r.c_str())));
     } else {
-      std::fprintf(
-          stderr,
-          "usage: %s [--meshes DIR] [--runs N] [--res 16,32,64] [--quick] [--profile] [--wg N]\n",
-          argv[0]);
+      std::fprintf(stderr,
+                   "usage: %s [--meshes DIR] [--runs N] [--res 16,32,64] [--quick] [--profile] "
+                   "[--wg N] [--only torus|meshes]\n",
+                   argv[0]);
       return 2;
     }
   }
@@ -150,15 +154,17 @@ int main(int argc, char** argv) {
   const std::vector<std::pair<int, int>> tess = {{72, 36},   {144, 72},  {224, 112},
                                                  {316, 158}, {448, 224}, {632, 316}};
   for (const auto& [ring, tube] : tess) {
-    if (quick && ring > 316) break;
+    if (!torusRows || (quick && ring > 316)) break;
     objects.emplace_back("torus", normalizedToDiagonal(torus(ring, tube), 0.18f));
   }
-  if (!quick) {
+  if (!quick && meshRows) {
     for (const char* name :
          {"newell-teapot.obj", "stanford-bunny.obj", "stanford-armadillo-100k.obj",
           "stanford-dragon-100k.obj", "igea-268k.obj", "stanford-armadillo-400k-subdiv.obj"}) {
       if (auto m = readObj(meshDir / name)) {
         objects.emplace_back(name, normalizedToDiagonal(*m, 0.18f));
+      } else {
+        std::fprintf(stderr, "%s: not found or unreadable in %s\n", name, meshDir.c_str());
       }
     }
   }

@@ -17,6 +17,7 @@
 
 #include "mesh.h"
 #include "mesh_distance.h"
+#include "mesh_io.h"
 #include "sdf_cpu.h"
 #include "sdf_grid.h"
 #include "test_support.h"
@@ -47,40 +48,11 @@ std::unique_ptr<StandaloneVulkan> makeDevice() {
 
 // ---- Meshes ---------------------------------------------------------------------------------
 
-// Minimal OBJ reader (v and f lines, fan-triangulated, degenerate triangles dropped) so this
-// test does not wait for mesh_io; loadMesh replaces it once that lands on main.
+// A mesh file through the project's loader (OBJ or PLY); nothing when it cannot be read.
 std::optional<TriangleMesh> readObj(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) return std::nullopt;
-  TriangleMesh mesh;
-  std::string line;
-  std::vector<uint32_t> face;
-  while (std::getline(in, line)) {
-    if (line.size() < 2) continue;
-    if (line[0] == 'v' && line[1] == ' ') {
-      glm::vec3 p;
-      std::istringstream(line.substr(2)) >> p.x >> p.y >> p.z;
-      mesh.positions.push_back(p);
-    } else if (line[0] == 'f' && line[1] == ' ') {
-      std::istringstream s(line.substr(2));
-      std::string token;
-      face.clear();
-      while (s >> token) {
-        long idx = std::stol(token.substr(0, token.find('/')));
-        face.push_back(uint32_t(idx < 0 ? long(mesh.positions.size()) + idx : idx - 1));
-      }
-      for (size_t k = 2; k < face.size(); ++k) {
-        const uint32_t a = face[0], b = face[k - 1], c = face[k];
-        if (a == b || b == c || a == c) continue;
-        const glm::dvec3 n =
-            glm::cross(glm::dvec3(mesh.positions[b]) - glm::dvec3(mesh.positions[a]),
-                       glm::dvec3(mesh.positions[c]) - glm::dvec3(mesh.positions[a]));
-        if (n == glm::dvec3(0.0)) continue;
-        mesh.indices.insert(mesh.indices.end(), {a, b, c});
-      }
-    }
-  }
-  return mesh;
+  auto loaded = loadMesh(path);
+  if (!loaded) return std::nullopt;
+  return std::move(loaded->mesh);
 }
 
 std::optional<TriangleMesh> sharedTestMesh(const std::string& name) {

@@ -20,6 +20,7 @@
 #include "mesh_io.h"
 #include "sdf_cpu.h"
 #include "sdf_grid.h"
+#include "shapes.h"
 #include "test_support.h"
 #include "vk_sdf_backend.h"
 #include "vk_sdf_builder.h"
@@ -63,26 +64,10 @@ std::optional<TriangleMesh> sharedTestMesh(const std::string& name) {
   return normalizedToDiagonal(*mesh, 0.18f);
 }
 
-// A torus in the XZ plane (closed, genus 1, outward counter-clockwise faces), made here so the
-// tests that need no shared mesh run everywhere.
+// A torus in the XZ plane (the core's shape: closed, genus 1, outward counter-clockwise faces),
+// so the tests that need no shared mesh run everywhere.
 TriangleMesh localTorus(float major, float minor, int ring, int tube) {
-  TriangleMesh m;
-  for (int i = 0; i < ring; ++i) {
-    const float u = 2.0f * float(M_PI) * float(i) / float(ring);
-    for (int j = 0; j < tube; ++j) {
-      const float v = 2.0f * float(M_PI) * float(j) / float(tube);
-      const float r = major + minor * std::cos(v);
-      m.positions.emplace_back(r * std::cos(u), minor * std::sin(v), r * std::sin(u));
-    }
-  }
-  auto at = [&](int i, int j) { return uint32_t((i % ring) * tube + (j % tube)); };
-  for (int i = 0; i < ring; ++i) {
-    for (int j = 0; j < tube; ++j) {
-      const uint32_t a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
-      m.indices.insert(m.indices.end(), {a, c, b, a, d, c});
-    }
-  }
-  return m;
+  return makeTorus(major, minor, ring, tube);
 }
 
 // ---- Reference ------------------------------------------------------------------------------

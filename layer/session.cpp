@@ -11,6 +11,14 @@ std::shared_ptr<InstanceState> instanceOf(XrInstance handle) {
   return instances().find(key(handle));
 }
 
+// Records a space the app created on `s`, so grasp targets placed in it can be validated and
+// located, and so it is forgotten with its session.
+void rememberSpace(const std::shared_ptr<SessionState>& s, XrSpace space) {
+  std::lock_guard lock(s->mutex);
+  s->spaces.insert(key(space));
+  spaceOwners().insert(key(space), s);
+}
+
 }  // namespace
 
 XrResult XRAPI_CALL SdfgXrGetSystemProperties(XrInstance instance, XrSystemId systemId,
@@ -123,11 +131,7 @@ XrResult XRAPI_CALL SdfgXrCreateReferenceSpace(XrSession session,
   auto s = sessions().find(key(session));
   if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
   const XrResult r = s->instance->next.xrCreateReferenceSpace(session, info, space);
-  if (XR_SUCCEEDED(r)) {
-    std::lock_guard lock(s->mutex);
-    s->spaces.insert(key(*space));
-    spaceOwners().insert(key(*space), s);
-  }
+  if (XR_SUCCEEDED(r)) rememberSpace(s, *space);
   return r;
   SDFG_ENTRY_END(cmd)
 }
@@ -139,11 +143,7 @@ XrResult XRAPI_CALL SdfgXrCreateActionSpace(XrSession session, const XrActionSpa
   auto s = sessions().find(key(session));
   if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
   const XrResult r = s->instance->next.xrCreateActionSpace(session, info, space);
-  if (XR_SUCCEEDED(r)) {
-    std::lock_guard lock(s->mutex);
-    s->spaces.insert(key(*space));
-    spaceOwners().insert(key(*space), s);
-  }
+  if (XR_SUCCEEDED(r)) rememberSpace(s, *space);
   return r;
   SDFG_ENTRY_END(cmd)
 }

@@ -731,12 +731,13 @@ int main(int argc, char** argv) {
     std::fputs(kUsage, stdout);
     return 0;
   }
+  const unsigned threads =
+      o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
   if (!o.reportFrom.empty()) {
     // A long run's results, reported again (new plots, new notes) without solving again.
-    const bool ok = bench::runReport(bench::ReportRequest{
-        o.report, o.reportFrom, bench::shellCommandLine(argc, argv),
-        o.threads != 0 ? o.threads : std::max(1u, std::thread::hardware_concurrency()),
-        o.scalingQuick, o.resolution, sharedMeshesDir()});
+    const bool ok = bench::runReport(
+        bench::ReportRequest{o.report, o.reportFrom, bench::shellCommandLine(argc, argv), threads,
+                             o.scalingQuick, o.resolution, sharedMeshesDir()});
     return ok ? 0 : 1;
   }
 
@@ -760,8 +761,6 @@ int main(int argc, char** argv) {
     for (const auto& f : files) sources.push_back({f.stem().string(), f, {}});
   }
 
-  const unsigned threads =
-      o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
   const HandModel hand = HandModel::defaultAdult(Hand::right);
   GridBox box = GridBox::referenceDefault();
   box.resolution = glm::uvec3(uint32_t(o.resolution));

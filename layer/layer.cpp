@@ -76,6 +76,7 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
   state->appHandTracking = contains(appExtensions, XR_EXT_HAND_TRACKING_EXTENSION_NAME);
   state->appMotionRange = contains(appExtensions, XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME);
   state->appDebugUtils = contains(appExtensions, XR_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  state->appVulkan2 = contains(appExtensions, XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME);
 
   // The runtime's extensions cannot be listed from here: layers below (core validation 1.0.20)
   // refuse xrEnumerateInstanceExtensionProperties without an instance. So ask by trying, as
@@ -141,6 +142,16 @@ XrResult XRAPI_CALL SdfgXrDestroyInstance(XrInstance instance) {
   auto state = instances().find(key(instance));
   if (state == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(instance) is not valid");
   clearDebugUtilsSink(instance);
+  // Sessions the app did not destroy go with the instance: their GPU work first (waits for
+  // builds in flight), while the app's Vulkan device surely exists.
+  std::vector<std::shared_ptr<SessionState>> own;
+  sessions().forEach([&](const std::shared_ptr<SessionState>& s) {
+    if (s->instance == state) own.push_back(s);
+  });
+  for (const auto& s : own) {
+    std::lock_guard lock(s->mutex);  // not under the map's lock: sessions lock it the other way
+    dropGpuWork(*s);
+  }
   const XrResult r = state->next.xrDestroyInstance(instance);
   if (XR_SUCCEEDED(r)) {
     // The instance took its sessions and their children with it.
@@ -195,6 +206,7 @@ enum class Gate {
   active,        // only when the layer is active on the instance, else the next layer's function
   autoGrasp,     // XR_SDFG_auto_grasp commands: only when the app enabled it
   handTracking,  // XR_EXT_hand_tracking commands: enabled by the app; ours when active
+  vulkan2,       // XR_KHR_vulkan_enable2 commands: ours when active and the app enabled it
 };
 
 struct Route {
@@ -215,6 +227,10 @@ const Route kRoutes[] = {
     SDFG_ROUTE(XrCreateSession, Gate::active),
     SDFG_ROUTE(XrDestroySession, Gate::active),
     SDFG_ROUTE(XrWaitFrame, Gate::active),
+    SDFG_ROUTE(XrBeginFrame, Gate::active),
+    SDFG_ROUTE(XrEndFrame, Gate::active),
+    SDFG_ROUTE(XrCreateVulkanInstanceKHR, Gate::vulkan2),
+    SDFG_ROUTE(XrCreateVulkanDeviceKHR, Gate::vulkan2),
     SDFG_ROUTE(XrCreateReferenceSpace, Gate::active),
     SDFG_ROUTE(XrCreateActionSpace, Gate::active),
     SDFG_ROUTE(XrDestroySpace, Gate::active),
@@ -270,6 +286,12 @@ XrResult XRAPI_CALL SdfgXrGetInstanceProcAddr(XrInstance instance, const char* n
         if (!state->appAutoGrasp) return XR_ERROR_FUNCTION_UNSUPPORTED;
         *function = route.function;
         return XR_SUCCESS;
+      case Gate::vulkan2:
+        if (state->active && state->appVulkan2 && state->appAutoGrasp) {
+          *function = route.function;
+          return XR_SUCCESS;
+        }
+        break;
       case Gate::handTracking:
         if (!state->appHandTracking) return XR_ERROR_FUNCTION_UNSUPPORTED;
         if (state->active) {

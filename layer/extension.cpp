@@ -351,6 +351,7 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
     info->gpuBuildCount = st.gpuBuilds;
     info->cpuBuildCount = st.cpuBuilds;
     info->gpuFailed = st.gpuFailed ? XR_TRUE : XR_FALSE;
+    info->pendingGpuBuilds = uint32_t(s->grasp->pendingBuilds());
   }
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)

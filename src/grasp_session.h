@@ -127,6 +127,8 @@ class GraspSession {
   // Drops the deferred backend (waits for its work in flight): before the device goes away.
   void dropDeferred();
   const SdfBuildStats& buildStats() const { return stats_; }
+  // Hands whose deferred build was requested and not yet collected.
+  int pendingBuilds() const { return int(hands_[0].pending) + int(hands_[1].pending); }
 
   const HandGrasp& grasp(Hand hand) const { return hands_[size_t(hand)].grasp; }
   // The model the hand's grasp was solved with (default adult until a tracked grab fits one).

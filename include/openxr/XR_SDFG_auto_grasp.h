@@ -155,6 +155,7 @@ typedef struct XrGraspBuildInfoSDFG {
   uint64_t gpuBuildCount;                // builds of the session done on the GPU so far
   uint64_t cpuBuildCount;                // and on the CPU
   XrBool32 gpuFailed;  // the GPU path failed (device lost or any Vulkan error): CPU from then on
+  uint32_t pendingGpuBuilds;  // GPU builds requested and not yet collected (0..2)
 } XrGraspBuildInfoSDFG;
 
 // Solver strategies; the layer's configuration picks the default.

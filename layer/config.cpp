@@ -57,7 +57,14 @@ bool applyConfigValue(Config& config, const std::string& key, const std::string&
   } else if (key == "synthesis") {
     ok = parseBool(value, c.synthesis);
   } else if (key == "gpu") {
-    ok = parseBool(value, c.gpu);
+    bool flag = false;
+    if (value == "auto") {
+      c.gpu = Config::Gpu::automatic;
+      ok = true;
+    } else if (parseBool(value, flag)) {
+      c.gpu = flag ? Config::Gpu::on : Config::Gpu::off;
+      ok = true;
+    }
   } else if (key == "extra_queue") {
     ok = parseBool(value, c.extraQueue);
   } else if (key == "test_gpu_fault") {

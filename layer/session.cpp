@@ -76,6 +76,7 @@ XrResult XRAPI_CALL SdfgXrCreateSession(XrInstance instance, const XrSessionCrea
   std::unique_ptr<DeferredSdfBackend> gpu;
   if (s->vulkan && state->appAutoGrasp) gpu = makeVulkanBackend(*s);
   s->grasp = std::make_unique<GraspSession>(makeCpuSdfBackend(2), std::move(gpu));
+  s->grasp->setDeferredForMeshTargets(s->gpuForArrayTargets);
   if (Status st = s->grasp->configure(s->settings); st != Status::ok) {
     SDFG_LOG_WARN(cmd, "configured solver '%s' is not usable (%s); using 'paper'",
                   s->settings.solver.c_str(), toString(st));

@@ -119,6 +119,8 @@ struct SessionState {
   // The Vulkan backend inside `grasp` (null: CPU only), and whether it has a queue of its own.
   VkGraspBackend* vulkanBackend = nullptr;
   bool ownQueue = false;
+  // Array targets build on the device too (config gpu, device type); see makeVulkanBackend().
+  bool gpuForArrayTargets = false;
   GraspSettings settings;
   std::unordered_map<uint64_t, std::shared_ptr<TargetState>> targets;
 };

@@ -65,11 +65,12 @@ std::unique_ptr<DeferredSdfBackend> makeVulkanBackend(SessionState& s) {
   constexpr const char* cmd = "xrCreateSession";
   s.vulkanBackend = nullptr;
   s.ownQueue = false;
+  s.gpuForArrayTargets = false;
   if (!s.vulkan) return nullptr;
 #if SDFG_LAYER_VULKAN
   InstanceState& inst = *s.instance;
-  if (!inst.config.gpu) {
-    SDFG_LOG_INFO(cmd, "gpu = false: grab-box SDFs on the CPU");
+  if (inst.config.gpu == Config::Gpu::off) {
+    SDFG_LOG_INFO(cmd, "gpu = off: grab-box SDFs on the CPU");
     return nullptr;
   }
   const XrGraphicsBindingVulkanKHR& b = s.vulkanBinding;
@@ -105,8 +106,20 @@ std::unique_ptr<DeferredSdfBackend> makeVulkanBackend(SessionState& s) {
   (*backend)->injectFault(faultFromConfig(inst.config.testGpuFault));
   s.vulkanBackend = backend->get();
   s.ownQueue = own.has_value();
-  SDFG_LOG_INFO(cmd, "grab-box SDFs on the app's Vulkan device (%s)",
-                s.ownQueue ? "the layer's own queue" : "the app's queue inside frame calls");
+  // A CPU implementation of Vulkan runs our compute passes on the cores the CPU builder would
+  // use, several times slower (docs/benchmarks-vulkan.md): with gpu = auto only targets that
+  // exist solely in the app's buffers go there.
+  VkPhysicalDeviceProperties props{};
+  if (auto getProps = reinterpret_cast<PFN_vkGetPhysicalDeviceProperties>(
+          app.getInstanceProcAddr(b.instance, "vkGetPhysicalDeviceProperties")))
+    getProps(b.physicalDevice, &props);
+  const bool cpuDevice = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  s.gpuForArrayTargets = inst.config.gpu == Config::Gpu::on || !cpuDevice;
+  SDFG_LOG_INFO(
+      cmd, "grab-box SDFs of %s on the app's Vulkan device '%s' (%s)",
+      s.gpuForArrayTargets ? "every target" : "buffer targets only (gpu = auto, CPU device)",
+      props.deviceName,
+      s.ownQueue ? "the layer's own queue" : "the app's queue inside frame calls");
   return std::move(backend.value());
 #else
   SDFG_LOG_INFO(cmd, "built without the Vulkan backend: grab-box SDFs on the CPU");
@@ -187,7 +200,7 @@ XrResult XRAPI_CALL SdfgXrCreateVulkanDeviceKHR(XrInstance instance,
     std::lock_guard lock(state->vulkanMutex);
     vkInstance = state->lastVulkanInstance;
   }
-  if (state->config.gpu && state->config.extraQueue && info != nullptr &&
+  if (state->config.gpu != Config::Gpu::off && state->config.extraQueue && info != nullptr &&
       info->type == XR_TYPE_VULKAN_DEVICE_CREATE_INFO_KHR && info->vulkanCreateInfo != nullptr &&
       info->pfnGetInstanceProcAddr != nullptr && info->vulkanPhysicalDevice != VK_NULL_HANDLE &&
       vkInstance != VK_NULL_HANDLE && device != nullptr && vulkanResult != nullptr) {

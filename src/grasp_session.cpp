@@ -194,7 +194,7 @@ Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Targ
       return s;
     hand.prepared = true;
   }
-  if (deferredUsable()) {
+  if (deferredUsable() && (target.distance == nullptr || deferredForMeshTargets_)) {
     const TriangleMesh* mesh = target.distance ? &target.distance->mesh() : nullptr;
     const Status s =
         deferred_->request(slot, id, target.version, mesh, objectFromHand, settings_.box);

@@ -124,6 +124,9 @@ class GraspSession {
   }
   bool deferredUsable() const { return deferred_ != nullptr && !deferred_->failed(); }
   DeferredSdfBackend* deferred() { return deferred_.get(); }
+  // Whether targets added with a CPU mesh (addTarget) build on the deferred backend too (the
+  // default) or on the CPU backend; device targets always use the deferred one.
+  void setDeferredForMeshTargets(bool deferred) { deferredForMeshTargets_ = deferred; }
   // Drops the deferred backend (waits for its work in flight): before the device goes away.
   void dropDeferred();
   const SdfBuildStats& buildStats() const { return stats_; }
@@ -166,6 +169,7 @@ class GraspSession {
 
   std::unique_ptr<SdfBackend> backend_;
   std::unique_ptr<DeferredSdfBackend> deferred_;
+  bool deferredForMeshTargets_ = true;
   SdfBuildStats stats_;
   GraspSettings settings_;
   std::map<uint64_t, Target> targets_;

@@ -22,10 +22,13 @@ const char* graphicsName(Graphics g) {
   return g == Graphics::vulkan ? "XR_KHR_vulkan_enable" : "XR_KHR_vulkan_enable2";
 }
 
-// A right hand at `grip` that squeezes fully from frame 3.
-XrEnv squeezeEnv(const XrPosef& grip) {
+// A right hand at `grip` that squeezes fully from frame 3. `gpu` is the layer's gpu key: these
+// tests ask for "on", because with "auto" a CPU device such as lavapipe builds array targets on
+// the CPU.
+XrEnv squeezeEnv(const XrPosef& grip, const char* gpu = "on") {
   XrEnv env;
   env.handTracking = "absent";
+  env.extra = {{"SDFG_AUTOGRASP_GPU", gpu}};
   env.script = gripLine(0, "right", grip) + squeezeLine(0, "right", 0.0f) +
                squeezeLine(2, "right", 0.0f) + squeezeLine(3, "right", 1.0f);
   return env;
@@ -295,7 +298,7 @@ TEST_CASE("A device loss on the GPU path falls back to the CPU and the hand stil
   for (const char* fault : {"lost_at_submit", "lost_at_poll"}) {
     CAPTURE(fault);
     XrEnv env = squeezeEnv(grip);
-    env.extra = {{"SDFG_AUTOGRASP_TEST_GPU_FAULT", fault}};
+    env.extra.push_back({"SDFG_AUTOGRASP_TEST_GPU_FAULT", fault});
     applyEnv(env);
     const size_t messagesBefore = vulkanMessages().size();
     {
@@ -322,4 +325,37 @@ TEST_CASE("A device loss on the GPU path falls back to the CPU and the hand stil
     CHECK(validationLog().empty());
     CHECK(vulkanMessages().size() == messagesBefore);
   }
+}
+
+TEST_CASE("With gpu = auto, array targets build on the CPU when the Vulkan device is a CPU",
+          "[layer][vulkan]") {
+  if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+  const XrVector3f centre = boxCentreInLocal(grip, /*right=*/true);
+  const float radius = 0.04f;
+  applyEnv(squeezeEnv(grip, "auto"));
+  {
+    App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME},
+             true,
+             Graphics::vulkan2});
+    REQUIRE(app.ok());
+    VkPhysicalDeviceProperties props{};
+    vkGetPhysicalDeviceProperties(app.vk.physicalDevice, &props);
+    CAPTURE(props.deviceName);
+    const bool cpuDevice = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    Ext ext(app);
+    XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
+    makeTarget(app, ext, makeIcosphere(radius, 4), {{0, 0, 0, 1}, centre});
+    State s = runUntilGrasping(app, ext);
+    REQUIRE(s.state.isGrasping);
+    // The session keeps its device backend either way (buffer targets need it).
+    CHECK(s.build.sessionBackend == XR_GRASP_SDF_BACKEND_VULKAN_SDFG);
+    CHECK(s.build.graspBackend ==
+          (cpuDevice ? XR_GRASP_SDF_BACKEND_CPU_SDFG : XR_GRASP_SDF_BACKEND_VULKAN_SDFG));
+    CHECK((s.build.cpuBuildCount > 0) == cpuDevice);
+    CHECK((s.build.gpuBuildCount > 0) == !cpuDevice);
+    checkContacts(outcome(app, tracker, s),
+                  [&](const XrVector3f& p) { return length(sub(p, centre)) - radius; });
+  }
+  CHECK(validationLog().empty());
 }

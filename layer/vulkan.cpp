@@ -139,30 +139,34 @@ void dropGpuWork(SessionState& s) {
   if (s.grasp != nullptr) s.grasp->dropDeferred();
 }
 
-XrResult XRAPI_CALL SdfgXrBeginFrame(XrSession session, const XrFrameBeginInfo* info) {
-  constexpr const char* cmd = "xrBeginFrame";
-  SDFG_ENTRY_BEGIN
+namespace {
+
+// xrBeginFrame and xrEndFrame: the app holds its queue for the runtime during these calls, so
+// pending builds may go on it before the call goes down.
+template <typename Info, typename Next>
+XrResult submitThenCallDown(const char* cmd, XrSession session, const Info* info, Next next) {
   auto s = sessions().find(key(session));
   if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
   if (s->vulkan) {
-    // The app holds the queue for the runtime during this call: ours to use before calling down.
     std::lock_guard lock(s->mutex);
     submitGpuWork(*s, true, cmd);
   }
-  return s->instance->next.xrBeginFrame(session, info);
+  return (s->instance->next.*next)(session, info);
+}
+
+}  // namespace
+
+XrResult XRAPI_CALL SdfgXrBeginFrame(XrSession session, const XrFrameBeginInfo* info) {
+  constexpr const char* cmd = "xrBeginFrame";
+  SDFG_ENTRY_BEGIN
+  return submitThenCallDown(cmd, session, info, &NextDispatch::xrBeginFrame);
   SDFG_ENTRY_END(cmd)
 }
 
 XrResult XRAPI_CALL SdfgXrEndFrame(XrSession session, const XrFrameEndInfo* info) {
   constexpr const char* cmd = "xrEndFrame";
   SDFG_ENTRY_BEGIN
-  auto s = sessions().find(key(session));
-  if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
-  if (s->vulkan) {
-    std::lock_guard lock(s->mutex);
-    submitGpuWork(*s, true, cmd);
-  }
-  return s->instance->next.xrEndFrame(session, info);
+  return submitThenCallDown(cmd, session, info, &NextDispatch::xrEndFrame);
   SDFG_ENTRY_END(cmd)
 }
 

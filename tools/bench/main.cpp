@@ -75,6 +75,9 @@ const char* kUsage =
     "  --scaling          also time the SDF builds against triangles and resolution, the\n"
     "                     --sdf-backend list side by side (default: cpu and vulkan)\n"
     "  --scaling-quick    --scaling on small tori only (tests)\n"
+    "  --scaling-json FILE also write the sweep's figures as JSON; implies --scaling\n"
+    "  --scaling-from FILE the sweep's figures from a JSON --scaling-json wrote, instead of\n"
+    "                     sweeping again\n"
     "  --report-from FILE with --report: write the report from a JSON an earlier run wrote\n"
     "                     (with --json) instead of running the meshes again\n"
     "  --help             this text\n"
@@ -96,6 +99,8 @@ struct Options {
   bool sdfBackendsGiven = false;  // else --scaling compares cpu and vulkan
   std::string json;
   std::string report;
+  std::string scalingJson;  // the sweep's figures as JSON
+  std::string scalingFrom;  // a sweep's JSON to report instead of sweeping again
   bool scaling = false;
   bool scalingQuick = false;
   std::string reportFrom;  // a results JSON to report on instead of running
@@ -223,6 +228,16 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
       if (auto e = needValue(v)) return e;
       if (v.empty()) return UsageError{"--report: empty folder name"};
       o.report = v;
+      o.scaling = true;
+    } else if (arg == "--scaling-json") {
+      if (auto e = needValue(v)) return e;
+      if (v.empty()) return UsageError{"--scaling-json: empty file name"};
+      o.scalingJson = v;
+      o.scaling = true;
+    } else if (arg == "--scaling-from") {
+      if (auto e = needValue(v)) return e;
+      if (v.empty()) return UsageError{"--scaling-from: empty file name"};
+      o.scalingFrom = v;
       o.scaling = true;
     } else if (arg == "--report-from") {
       if (auto e = needValue(v)) return e;
@@ -583,51 +598,15 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
 // ---------------------------------------------------------------------------------------------
 // Output
 
-std::string jsonString(const std::string& s) {
-  std::string out = "\"";
-  for (unsigned char c : s) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (c < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
-        } else {
-          out += char(c);
-        }
-    }
-  }
-  return out + "\"";
-}
-
-std::string jsonNumber(double v) {
-  if (!std::isfinite(v)) return "null";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
 // Per-finger counts, thumb to little.
 std::string jsonCounts(const std::array<long long, kFingerCount>& counts) {
   std::string out = "[";
   for (int f = 0; f < kFingerCount; ++f) out += (f ? ", " : "") + std::to_string(counts[f]);
   return out + "]";
 }
+
+using bench::jsonNumber;
+using bench::jsonString;
 
 bool writeJson(const std::string& file, const Options& o, const std::vector<Row>& rows) {
   std::ofstream out(file);
@@ -735,7 +714,7 @@ void printTables(const Options& o, const std::vector<Row>& rows) {
   for (const auto& m : meshes) {
     size_t triangles = 0;
     for (const Row& r : rows) {
-      if (r.mesh == m) triangles = r.triangles;
+      if (r.mesh == m && triangles == 0) triangles = r.triangles;
     }
     std::printf(" %*zu", int(width), triangles);
   }
@@ -828,9 +807,9 @@ int main(int argc, char** argv) {
   };
   if (!o.reportFrom.empty()) {
     // A long run's results, reported again (new plots, new notes) without solving again.
-    return reportExitCode(bench::runReport(
-        bench::ReportRequest{o.report, o.reportFrom, bench::shellCommandLine(argc, argv), threads,
-                             o.scalingQuick, o.resolution, sharedMeshesDir(), scalingBackends}));
+    return reportExitCode(bench::runReport(bench::ReportRequest{
+        o.report, o.reportFrom, bench::shellCommandLine(argc, argv), threads, o.scalingQuick,
+        o.resolution, sharedMeshesDir(), scalingBackends, o.scalingJson, o.scalingFrom}));
   }
 
   std::vector<MeshSource> sources;
@@ -928,9 +907,9 @@ int main(int argc, char** argv) {
     failed = true;
   }
   if (o.scaling) {
-    const int code = reportExitCode(bench::runReport(
-        bench::ReportRequest{o.report, o.json, bench::shellCommandLine(argc, argv), threads,
-                             o.scalingQuick, o.resolution, sharedMeshesDir(), scalingBackends}));
+    const int code = reportExitCode(bench::runReport(bench::ReportRequest{
+        o.report, o.json, bench::shellCommandLine(argc, argv), threads, o.scalingQuick,
+        o.resolution, sharedMeshesDir(), scalingBackends, o.scalingJson, o.scalingFrom}));
     failed = failed || code == 1;
     backendMissing = backendMissing || code == kExitBackendUnavailable;
   }

@@ -503,6 +503,135 @@ void printScaling(const ScalingResults& results) {
 // ---------------------------------------------------------------------------------------------
 // Report
 
+std::string jsonString(const std::string& s) {
+  std::string out = "\"";
+  for (unsigned char c : s) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (c < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", c);
+          out += buf;
+        } else {
+          out += char(c);
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::string jsonNumber(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::optional<Error> writeScalingJson(const fs::path& file, const ScalingResults& r) {
+  std::ofstream out(file);
+  auto strings = [](const std::vector<std::string>& v) {
+    std::string a = "[";
+    for (size_t i = 0; i < v.size(); ++i) a += (i ? ", " : "") + jsonString(v[i]);
+    return a + "]";
+  };
+  // Per builder, by name: {"cpu": 1.2, "vulkan": 30}.
+  auto perBuilder = [&](const std::vector<double>& ms) {
+    std::string o = "{";
+    for (size_t i = 0; i < ms.size() && i < r.builders.size(); ++i) {
+      o += (i ? ", " : "") + jsonString(r.builders[i]) + ": " + jsonNumber(ms[i]);
+    }
+    return o + "}";
+  };
+  auto points = [&](const std::vector<ScalingPoint>& v) {
+    std::string a = "[";
+    for (size_t i = 0; i < v.size(); ++i) {
+      const ScalingPoint& p = v[i];
+      a += std::string(i ? ",\n" : "\n") + "    {\"mesh\": " + jsonString(p.mesh) +
+           ", \"triangles\": " + std::to_string(p.triangles) +
+           ", \"resolution\": " + std::to_string(p.resolution) +
+           ", \"setup_ms\": " + jsonNumber(p.prepareMs) +
+           ",\n     \"build_ms\": " + perBuilder(p.buildMs) +
+           ", \"build_sample_ms\": " + perBuilder(p.buildSampleMs) + "}";
+    }
+    return a + "\n  ]";
+  };
+  out << "{\n  \"backends\": " << strings(r.builders) << ",\n  \"devices\": " << strings(r.devices)
+      << ",\n  \"unavailable\": " << strings(r.unavailable) << ",\n  \"repeats\": " << r.repeats
+      << ",\n  \"by_triangles\": " << points(r.byTriangles)
+      << ",\n  \"by_resolution\": " << points(r.byResolution) << "\n}\n";
+  out.flush();
+  if (!out) return makeError(Status::io_error, file.string() + ": cannot write");
+  return std::nullopt;
+}
+
+Result<ScalingResults> readScalingJson(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) return makeError(Status::io_error, file.string() + ": cannot read");
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string body = text.str();
+  std::string error;
+  const std::optional<Json> json = JsonParser(body).parse(error);
+  if (!json) return makeError(Status::io_error, file.string() + ": " + error);
+  ScalingResults r;
+  auto strings = [&](const char* key) {
+    std::vector<std::string> out;
+    if (const Json* a = json->find(key); a && a->array()) {
+      for (const Json& v : *a->array()) out.push_back(v.string());
+    }
+    return out;
+  };
+  r.builders = strings("backends");
+  r.devices = strings("devices");
+  r.unavailable = strings("unavailable");
+  r.devices.resize(r.builders.size());
+  const Json* repeats = json->find("repeats");
+  r.repeats = repeats ? int(repeats->number()) : 0;
+  auto number = [](const Json& object, const char* key, const std::string& sub = {}) {
+    const Json* v = object.find(key);
+    if (v && !sub.empty()) v = v->find(sub);
+    return v ? v->number() : std::nan("");
+  };
+  auto points = [&](const char* key, std::vector<ScalingPoint>& out) -> bool {
+    const Json* a = json->find(key);
+    if (!a || !a->array()) return false;
+    for (const Json& p : *a->array()) {
+      ScalingPoint point;
+      point.mesh = p.find("mesh") ? p.find("mesh")->string() : "";
+      point.triangles = size_t(std::max(0.0, number(p, "triangles")));
+      point.resolution = int(std::max(0.0, number(p, "resolution")));
+      point.prepareMs = number(p, "setup_ms");
+      for (const std::string& b : r.builders) {
+        point.buildMs.push_back(number(p, "build_ms", b));
+        point.buildSampleMs.push_back(number(p, "build_sample_ms", b));
+      }
+      out.push_back(std::move(point));
+    }
+    return true;
+  };
+  if (r.builders.empty() || !points("by_triangles", r.byTriangles) ||
+      !points("by_resolution", r.byResolution)) {
+    return makeError(Status::io_error,
+                     file.string() + ": not a sweep (backends, by_triangles, by_resolution)");
+  }
+  return r;
+}
+
 fs::path reportResultsPath(const fs::path& dir) {
   std::error_code ec;
   fs::create_directories(dir / "bench-data", ec);
@@ -983,12 +1112,19 @@ ReportStatus runReport(const ReportRequest& request) {
   options.threads = request.threads;
   options.sharedMeshes = request.sharedMeshes;
   options.backends = request.backends;
-  auto scaling = runScaling(options);
+  auto scaling =
+      request.scalingFrom.empty() ? runScaling(options) : readScalingJson(request.scalingFrom);
   if (!scaling) {
     std::fprintf(stderr, "autograsp-bench: scaling: %s\n", scaling.error().message.c_str());
     return ReportStatus::failed;
   }
   printScaling(*scaling);
+  if (!request.scalingJson.empty()) {
+    if (auto error = writeScalingJson(request.scalingJson, *scaling)) {
+      std::fprintf(stderr, "autograsp-bench: scaling: %s\n", error->message.c_str());
+      return ReportStatus::failed;
+    }
+  }
   if (!request.dir.empty()) {
     if (auto error = writeReport(request, &*scaling)) {
       std::fprintf(stderr, "autograsp-bench: report: %s\n", error->message.c_str());

@@ -82,6 +82,8 @@ struct ReportRequest {
   int resolution = 16;                // the bench's grid resolution
   std::optional<std::filesystem::path> sharedMeshes;
   std::vector<std::string> backends = {"cpu", "vulkan"};  // ScalingOptions::backends
+  std::filesystem::path scalingJson;                      // when set, writeScalingJson() there
+  std::filesystem::path scalingFrom;  // when set, the sweep is read from there (readScalingJson)
 };
 
 enum class ReportStatus {
@@ -96,6 +98,19 @@ ReportStatus runReport(const ReportRequest& request);
 
 // The report alone, from the JSON and (optionally) a sweep already run; errors as runReport().
 std::optional<Error> writeReport(const ReportRequest& request, const ScalingResults* scaling);
+
+// The sweep as JSON: backends, devices, unavailable, repeats, and by_triangles / by_resolution
+// points {mesh, triangles, resolution, setup_ms, build_ms {backend: ms}, build_sample_ms {...}}.
+// Errors: io_error naming the file.
+std::optional<Error> writeScalingJson(const std::filesystem::path& file,
+                                      const ScalingResults& results);
+
+// A sweep written by writeScalingJson(). Errors: io_error naming the file and the problem.
+Result<ScalingResults> readScalingJson(const std::filesystem::path& file);
+
+// JSON text of a string (quoted, escaped) and of a number ("null" when not finite, else %.6g).
+std::string jsonString(const std::string& s);
+std::string jsonNumber(double v);
 
 // Where --report puts the bench's JSON when --json is not given (creates the folder).
 std::filesystem::path reportResultsPath(const std::filesystem::path& dir);

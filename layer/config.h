@@ -18,8 +18,16 @@ struct Config {
   unsigned resolution = 16;            // resolution: grid nodes per axis, 2..128
   float curlStep = 0.02f;              // curl_step: solver step along each finger curve
   bool synthesis = true;               // synthesis: offer XR_EXT_hand_tracking from controllers
-  bool gpu = true;                     // gpu: build SDFs on the app's Vulkan device when possible
-  std::string configPath;              // the file that was read, empty when none
+  // gpu: where Vulkan sessions build the SDFs of array targets. auto: on the app's device unless
+  // it is a CPU implementation (lavapipe, SwiftShader), where the CPU builder is faster and the
+  // two would compete for the same cores; on: on the device; off: on the CPU. Targets in the app's
+  // Vulkan buffers build on the device unless off.
+  enum class Gpu { automatic, on, off };
+  Gpu gpu = Gpu::automatic;
+  bool extraQueue = true;  // extra_queue: add a queue to Vulkan2 apps' devices when one is spare
+  // test_gpu_fault: none, lost_at_submit, lost_at_poll (tests only: a simulated device loss)
+  std::string testGpuFault = "none";
+  std::string configPath;  // the file that was read, empty when none
 };
 
 Config loadConfig();

@@ -10,109 +10,15 @@
 #include <map>
 #include <sstream>
 
+#include <glm/gtc/quaternion.hpp>
+
+#include "grasp_checks.h"
 #include "test_scenes.h"
 #include "xr_harness.h"
 
 namespace {
 
 using namespace sdfg::test;
-
-struct Ext {
-  PFN_xrCreateGraspTargetSDFG create;
-  PFN_xrDestroyGraspTargetSDFG destroy;
-  PFN_xrGetGraspStateSDFG state;
-  PFN_xrCreateHandTrackerEXT createTracker;
-  explicit Ext(const App& app)
-      : create(app.fn<PFN_xrCreateGraspTargetSDFG>("xrCreateGraspTargetSDFG")),
-        destroy(app.fn<PFN_xrDestroyGraspTargetSDFG>("xrDestroyGraspTargetSDFG")),
-        state(app.fn<PFN_xrGetGraspStateSDFG>("xrGetGraspStateSDFG")),
-        createTracker(app.fn<PFN_xrCreateHandTrackerEXT>("xrCreateHandTrackerEXT")) {}
-};
-
-XrHandTrackerEXT makeTracker(const App& app, const Ext& ext, XrHandEXT hand) {
-  XrHandTrackerCreateInfoEXT ci{XR_TYPE_HAND_TRACKER_CREATE_INFO_EXT};
-  ci.hand = hand;
-  ci.handJointSet = XR_HAND_JOINT_SET_DEFAULT_EXT;
-  XrHandTrackerEXT t = XR_NULL_HANDLE;
-  REQUIRE(ext.createTracker(app.session, &ci, &t) == XR_SUCCESS);
-  return t;
-}
-
-XrGraspTargetSDFG makeTarget(const App& app, const Ext& ext, const TestMesh& mesh,
-                             const XrPosef& pose) {
-  XrGraspTargetVerticesSDFG v{XR_TYPE_GRASP_TARGET_VERTICES_SDFG};
-  v.vertexCount = uint32_t(mesh.vertices.size());
-  v.vertices = mesh.vertices.data();
-  v.indexCount = uint32_t(mesh.indices.size());
-  v.indices = mesh.indices.data();
-  XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &v};
-  ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, app.local, pose};
-  XrGraspTargetSDFG t = XR_NULL_HANDLE;
-  REQUIRE(ext.create(app.session, &ci, &t) == XR_SUCCESS);
-  return t;
-}
-
-float length(const XrVector3f& v) {
-  return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
-}
-XrVector3f sub(const XrVector3f& a, const XrVector3f& b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-
-constexpr int kTips[5] = {XR_HAND_JOINT_THUMB_TIP_EXT, XR_HAND_JOINT_INDEX_TIP_EXT,
-                          XR_HAND_JOINT_MIDDLE_TIP_EXT, XR_HAND_JOINT_RING_TIP_EXT,
-                          XR_HAND_JOINT_LITTLE_TIP_EXT};
-
-// Runs a controller-only scene: the hand squeezes from frame 4; returns the located joints and
-// the grasp state after `frames` frames. `distance` is the exact signed distance of the object
-// in LOCAL space.
-struct GraspOutcome {
-  Joints joints;
-  XrGraspStateSDFG state{XR_TYPE_GRASP_STATE_SDFG};
-  int contacts = 0;
-};
-
-// Clearance of a finger's surface model: the capsules between its located joints, from the
-// proximal joint to the tip, radii interpolated between the joints' radii. Negative inside.
-float fingerClearance(const GraspOutcome& out, int finger,
-                      const std::function<float(const XrVector3f&)>& distance) {
-  const int first = finger == 0 ? XR_HAND_JOINT_THUMB_PROXIMAL_EXT : kTips[finger] - 3;
-  float best = std::numeric_limits<float>::infinity();
-  for (int j = first; j < kTips[finger]; ++j) {
-    const XrHandJointLocationEXT& a = out.joints.joints[j];
-    const XrHandJointLocationEXT& b = out.joints.joints[j + 1];
-    constexpr int kSteps = 8;
-    for (int s = 0; s <= kSteps; ++s) {
-      const float t = float(s) / kSteps;
-      const XrVector3f p{a.pose.position.x + t * (b.pose.position.x - a.pose.position.x),
-                         a.pose.position.y + t * (b.pose.position.y - a.pose.position.y),
-                         a.pose.position.z + t * (b.pose.position.z - a.pose.position.z)};
-      best = std::min(best, distance(p) - (a.radius + t * (b.radius - a.radius)));
-    }
-  }
-  return best;
-}
-
-void checkContacts(const GraspOutcome& out,
-                   const std::function<float(const XrVector3f&)>& distance) {
-  REQUIRE(out.joints.locations.isActive);
-  REQUIRE(out.state.isGrasping);
-  int contacts = 0;
-  for (int f = 0; f < 5; ++f) {
-    const XrHandJointLocationEXT& tip = out.joints.joints[kTips[f]];
-    const float d = distance(tip.pose.position);
-    const float clearance = fingerClearance(out, f, distance);
-    CAPTURE(f, d, tip.radius, clearance, out.state.fingers[f].curl);
-    // No tip inside the object, in contact or not.
-    CHECK(d > 0.0f);
-    if (!out.state.fingers[f].inContact) continue;
-    ++contacts;
-    // The finger touches the surface (with its tip, or its pad for whole-finger strategies):
-    // its closest part ends within 2 mm of it, on either side.
-    CHECK(std::abs(clearance) <= 0.002f);
-  }
-  CHECK(contacts >= 3);
-}
 
 GraspOutcome graspScene(const TestMesh& mesh, const XrPosef& objectPose, const XrPosef& grip,
                         const char* hand = "right", uint32_t resolution = 0) {
@@ -214,24 +120,47 @@ TEST_CASE("A squeezed hand closes onto a mug handle (torus bar) within 2 mm", "[
   checkContacts(out, [&](const XrVector3f& p) { return torusDistance(pose, major, minor, p); });
 }
 
-// Places `mesh` (unrotated) on the palm side of the open right hand driven by `grip`: moved
-// along the palm's normal until every sphere of the open hand is at least 3 mm clear of it, so
-// the grasp starts from a hand that does not already intersect the object.
-static XrPosef underOpenPalm(const TestMesh& mesh, const XrPosef& grip) {
+// Where the open right hand driven by `grip` is, in LOCAL space: its palm joint, the palm's
+// normal (out of the palm) and the axis across its fingers (index knuckle to little knuckle).
+struct OpenHand {
+  glm::vec3 palm, down, across;
+  glm::vec3 knuckles;  // the middle finger's proximal joint (its knuckle)
+};
+
+static OpenHand openHandInLocal(const XrPosef& grip) {
   using namespace sdfg;
   const HandModel model = HandModel::defaultAdult(Hand::right);
   const Pose localFromWrist = toPose(grip) * wristFromGrip(model).inverse();
   JointPoses open;
   model.pose(FingerCurls{}, open);
   const Pose& palm = open[int(Joint::palm)];
-  const glm::vec3 palmLocal = localFromWrist.transformPoint(palm.position);
-  const glm::vec3 down = localFromWrist.transformVector(palm.orientation * glm::vec3(0, -1, 0));
+  const glm::vec3 across =
+      open[int(Joint::little_proximal)].position - open[int(Joint::index_proximal)].position;
+  return {localFromWrist.transformPoint(palm.position),
+          localFromWrist.transformVector(palm.orientation * glm::vec3(0, -1, 0)),
+          glm::normalize(localFromWrist.transformVector(across)),
+          localFromWrist.transformPoint(open[int(Joint::middle_proximal)].position)};
+}
+
+// Places `mesh`, turned by `orientation` and shifted by `shift` from the palm joint, on the palm
+// side of the open right hand driven by `grip`: moved along the palm's normal until every sphere
+// of the open hand is at least 3 mm clear of it, so the grasp starts from a hand that does not
+// already intersect the object.
+static XrPosef underOpenPalm(const TestMesh& mesh, const XrPosef& grip,
+                             const XrQuaternionf& orientation = {0, 0, 0, 1},
+                             const glm::vec3& shift = glm::vec3(0.0f)) {
+  using namespace sdfg;
+  const HandModel model = HandModel::defaultAdult(Hand::right);
+  const Pose localFromWrist = toPose(grip) * wristFromGrip(model).inverse();
+  const OpenHand hand = openHandInLocal(grip);
   std::vector<BodySphere> spheres;
   for (int f = 0; f < kFingerCount; ++f) model.phalanxSpheres(Finger(f), 0.0f, spheres);
-  spheres.push_back({palm.position, model.jointRadius(Joint::palm), 0});
-  const ExactDistance atOrigin(mesh, XrPosef{{0, 0, 0, 1}, {0, 0, 0}});
+  JointPoses open;
+  model.pose(FingerCurls{}, open);
+  spheres.push_back({open[int(Joint::palm)].position, model.jointRadius(Joint::palm), 0});
+  const ExactDistance atOrigin(mesh, XrPosef{orientation, {0, 0, 0}});
   for (float s = 0.0f; s < 0.4f; s += 0.002f) {
-    const glm::vec3 t = palmLocal + down * s;
+    const glm::vec3 t = hand.palm + shift + hand.down * s;
     bool clear = true;
     for (const BodySphere& b : spheres) {
       const glm::vec3 p = localFromWrist.transformPoint(b.center) - t;
@@ -240,10 +169,40 @@ static XrPosef underOpenPalm(const TestMesh& mesh, const XrPosef& grip) {
         break;
       }
     }
-    if (clear) return XrPosef{{0, 0, 0, 1}, {t.x, t.y, t.z}};
+    if (clear) return XrPosef{orientation, {t.x, t.y, t.z}};
   }
   FAIL("no placement under the open palm keeps the hand clear of the mesh");
   return {};
+}
+
+// The procedural mug (shapes.h: one closed genus-1 surface, handle on its +X side) turned so the
+// handle points at the palm and its outer bar (along the mug's Y) runs across the fingers, then
+// brought under the open hand: the fingers close over the handle onto the cup.
+TEST_CASE("A squeezed hand closes over the mug's handle onto the cup within 2 mm",
+          "[layer][grasp]") {
+  const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+  const TestMesh mug = toTestMesh(sdfg::makeMug());
+  const OpenHand hand = openHandInLocal(grip);
+  const glm::vec3 x = -hand.down;
+  const glm::vec3 y = glm::normalize(hand.across - glm::dot(hand.across, x) * x);
+  const glm::quat q = glm::quat_cast(glm::mat3(x, y, glm::cross(x, y)));
+  // The bar lies across the base of the fingers, as in a hand holding a mug by its handle: under
+  // the knuckles, less the bar's centre-line offset from the mug's axis (about 6.9 cm along x).
+  glm::vec3 toKnuckles = hand.knuckles - hand.palm;
+  toKnuckles -= glm::dot(toKnuckles, hand.down) * hand.down;
+  const XrPosef pose = underOpenPalm(mug, grip, {q.x, q.y, q.z, q.w}, toKnuckles);
+  GraspOutcome out = graspScene(mug, pose, grip);
+  ExactDistance exact(mug, pose);
+  checkContacts(out, [&](const XrVector3f& p) { return exact(p); });
+  // The handle is in the closed hand: the bar under the knuckles (3 mm clear at the start) and
+  // the fingers over it, down to the cup's wall beyond it (the 2 cm hole is too small for a
+  // finger curling from above), the thumb on the cup's other side.
+  const glm::vec3 handle = toPose(pose).transformPoint(glm::vec3(0.069f, 0.0f, 0.0f));
+  CHECK(glm::length(handle - hand.knuckles) < 0.03f);
+  int onWall = 0;
+  for (const XrGraspFingerStateSDFG& f : out.state.fingers)
+    if (f.inContact && std::hypot(f.contactPoint.x, f.contactPoint.z) < 0.05f) ++onWall;
+  CHECK(onWall >= 3);
 }
 
 TEST_CASE("A squeezed hand closes onto the Stanford bunny within 2 mm", "[layer][grasp]") {

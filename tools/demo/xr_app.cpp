@@ -338,10 +338,16 @@ bool XrApp::locate(HandJoints& out) {
   return true;
 }
 
-bool XrApp::graspState(XrGraspStateSDFG& out) {
+bool XrApp::graspState(XrGraspStateSDFG& out, XrGraspBuildInfoSDFG* build) {
   XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
   out = XrGraspStateSDFG{XR_TYPE_GRASP_STATE_SDFG};
-  return getState_(session_, &gi, &out) == XR_SUCCESS;
+  if (build != nullptr) {
+    *build = XrGraspBuildInfoSDFG{XR_TYPE_GRASP_BUILD_INFO_SDFG};
+    out.next = build;
+  }
+  const bool ok = getState_(session_, &gi, &out) == XR_SUCCESS;
+  out.next = nullptr;
+  return ok;
 }
 
 bool XrApp::script(const std::string& text) {
@@ -396,10 +402,15 @@ GraspReading XrApp::grasp(XrGraspTargetSDFG target, const XrPosef& grip, XrGrasp
   }
   const auto start = std::chrono::steady_clock::now();
   XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG};
-  for (int i = 0; i < 60; ++i) {
+  XrGraspBuildInfoSDFG build{XR_TYPE_GRASP_BUILD_INFO_SDFG};
+  // 60 frames, and longer while a GPU build is still on its way (with gpu = on, a software
+  // Vulkan device takes up to a second): a real app keeps rendering meanwhile.
+  const auto deadline = start + std::chrono::seconds(10);
+  for (int i = 0;
+       i < 60 || (build.pendingGpuBuilds > 0 && std::chrono::steady_clock::now() < deadline); ++i) {
     frame();
     ++out.frames;
-    if (graspState(st) && st.isGrasping && st.target == target) {
+    if (graspState(st, &build) && st.isGrasping && st.target == target) {
       out.grasped = true;
       break;
     }

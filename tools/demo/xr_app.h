@@ -84,7 +84,8 @@ class XrApp {
   void pollEvents();
   void frame();
   bool locate(HandJoints& out);
-  bool graspState(XrGraspStateSDFG& out);
+  // `build`, when given, receives where the SDF was built (chained XrGraspBuildInfoSDFG).
+  bool graspState(XrGraspStateSDFG& out, XrGraspBuildInfoSDFG* build = nullptr);
   bool script(const std::string& text);
 
   XrInstance instance_ = XR_NULL_HANDLE;

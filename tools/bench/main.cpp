@@ -142,6 +142,32 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
       out = *v;
       return std::nullopt;
     };
+    // A value that must not be empty (a file or folder).
+    auto needName = [&](std::string& out, const char* what) -> std::optional<UsageError> {
+      if (auto e = needValue(out)) return e;
+      if (out.empty()) return UsageError{arg + ": empty " + what};
+      return std::nullopt;
+    };
+    // A comma-separated list of names from `names`, each kept once, in order.
+    auto needList = [&](const std::vector<std::string>& names, const std::string& what,
+                        std::vector<std::string>& out) -> std::optional<UsageError> {
+      std::string text;
+      if (auto e = needValue(text)) return e;
+      out.clear();
+      std::stringstream ss(text);
+      std::string item;
+      while (std::getline(ss, item, ',')) {
+        if (item.empty()) continue;
+        if (std::find(names.begin(), names.end(), item) == names.end()) {
+          std::string list;
+          for (const auto& k : names) list += (list.empty() ? "" : ", ") + k;
+          return UsageError{arg + ": unknown " + what + " \"" + item + "\"; known: " + list};
+        }
+        if (std::find(out.begin(), out.end(), item) == out.end()) out.push_back(item);
+      }
+      if (out.empty()) return UsageError{arg + ": no " + what + " given"};
+      return std::nullopt;
+    };
     std::string v;
     long long n = 0;
     if (arg == "--help" || arg == "-h") {
@@ -170,22 +196,7 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
       }
       o.seed = s;
     } else if (arg == "--methods") {
-      if (auto e = needValue(v)) return e;
-      o.methods.clear();
-      std::stringstream ss(v);
-      std::string m;
-      while (std::getline(ss, m, ',')) {
-        if (m.empty()) continue;
-        if (std::find(known.begin(), known.end(), m) == known.end()) {
-          std::string list;
-          for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-          return UsageError{"--methods: unknown method \"" + m + "\"; known: " + list};
-        }
-        if (std::find(o.methods.begin(), o.methods.end(), m) == o.methods.end()) {
-          o.methods.push_back(m);
-        }
-      }
-      if (o.methods.empty()) return UsageError{"--methods: no method given"};
+      if (auto e = needList(known, "method", o.methods)) return e;
     } else if (arg == "--da") {
       if (auto e = needValue(v)) return e;
       char* end = nullptr;
@@ -205,44 +216,24 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
       if (!parseInt(v, 0, 1024, n)) return UsageError{"--threads: \"" + v + "\" is not 0..1024"};
       o.threads = unsigned(n);
     } else if (arg == "--sdf-backend") {
-      if (auto e = needValue(v)) return e;
-      o.sdfBackends.clear();
-      o.sdfBackendsGiven = true;
-      std::stringstream ss(v);
-      std::string b;
-      while (std::getline(ss, b, ',')) {
-        if (b.empty()) continue;
-        if (b != tools::kCpuBackend && b != tools::kVulkanBackend) {
-          return UsageError{"--sdf-backend: unknown backend \"" + b + "\"; known: cpu, vulkan"};
-        }
-        if (std::find(o.sdfBackends.begin(), o.sdfBackends.end(), b) == o.sdfBackends.end()) {
-          o.sdfBackends.push_back(b);
-        }
+      if (auto e =
+              needList({tools::kCpuBackend, tools::kVulkanBackend}, "backend", o.sdfBackends)) {
+        return e;
       }
-      if (o.sdfBackends.empty()) return UsageError{"--sdf-backend: no backend given"};
+      o.sdfBackendsGiven = true;
     } else if (arg == "--json") {
-      if (auto e = needValue(v)) return e;
-      if (v.empty()) return UsageError{"--json: empty file name"};
-      o.json = v;
+      if (auto e = needName(o.json, "file name")) return e;
     } else if (arg == "--report") {
-      if (auto e = needValue(v)) return e;
-      if (v.empty()) return UsageError{"--report: empty folder name"};
-      o.report = v;
+      if (auto e = needName(o.report, "folder name")) return e;
       o.scaling = true;
     } else if (arg == "--scaling-json") {
-      if (auto e = needValue(v)) return e;
-      if (v.empty()) return UsageError{"--scaling-json: empty file name"};
-      o.scalingJson = v;
+      if (auto e = needName(o.scalingJson, "file name")) return e;
       o.scaling = true;
     } else if (arg == "--scaling-from") {
-      if (auto e = needValue(v)) return e;
-      if (v.empty()) return UsageError{"--scaling-from: empty file name"};
-      o.scalingFrom = v;
+      if (auto e = needName(o.scalingFrom, "file name")) return e;
       o.scaling = true;
     } else if (arg == "--report-from") {
-      if (auto e = needValue(v)) return e;
-      if (v.empty()) return UsageError{"--report-from: empty file name"};
-      o.reportFrom = v;
+      if (auto e = needName(o.reportFrom, "file name")) return e;
     } else if (arg == "--scaling" || arg == "--scaling-quick") {
       o.scaling = true;
       o.scalingQuick = o.scalingQuick || arg == "--scaling-quick";

@@ -1,7 +1,9 @@
 # Drives the built autograsp-bench like a user: a short run writes JSON with every key and finite
 # numbers; a broken mesh file is named, skipped, and the rest still runs; bad option values are a
-# usage error (exit 2).
-# Usage: cmake -DBENCH=<autograsp-bench> -DWORK=<scratch dir> -P bench_cli_test.cmake
+# usage error (exit 2); --sdf-backend vulkan without a device leaves its rows out and exits 3.
+# With -DPART=vulkan (a Vulkan device, e.g. lavapipe): --sdf-backend cpu,vulkan gives both rows
+# with finite figures, and --scaling-quick both columns; no device prints SDFG_SKIPPED.
+# Usage: cmake -DBENCH=<autograsp-bench> -DWORK=<scratch dir> [-DPART=vulkan] -P bench_cli_test.cmake
 cmake_minimum_required(VERSION 3.25)
 if(NOT BENCH OR NOT WORK)
   message(FATAL_ERROR "pass -DBENCH=<executable> -DWORK=<dir>")
@@ -32,12 +34,12 @@ function(check_row json i expected_grasps)
   set(required "solve_us median" "solve_us p95" "penetration_mm p99" "penetration_mm max"
                "contacts_mean")
   set(optional "tip_residual_mm median" "tip_residual_mm p95")
-  if(backend STREQUAL "cpu")
+  if(backend STREQUAL "cpu" OR backend STREQUAL "vulkan")
     list(APPEND required "sdf_build_ms median" "sdf_build_ms p95")
   elseif(backend STREQUAL "none")
     list(APPEND optional "sdf_build_ms median" "sdf_build_ms p95")
   else()
-    message(FATAL_ERROR "row ${i}: sdf_backend \"${backend}\" is neither cpu nor none")
+    message(FATAL_ERROR "row ${i}: sdf_backend \"${backend}\" is not cpu, vulkan or none")
   endif()
   foreach(path IN LISTS required optional)
     string(REPLACE " " ";" keys "${path}")
@@ -53,6 +55,82 @@ function(check_row json i expected_grasps)
     endif()
   endforeach()
 endfunction()
+
+# check_row on every row.
+function(check_rows json expected_grasps)
+  string(JSON rows LENGTH "${json}" rows)
+  math(EXPR last "${rows} - 1")
+  foreach(i RANGE ${last})
+    check_row("${json}" ${i} ${expected_grasps})
+  endforeach()
+endfunction()
+
+# Every row's backend, as "mesh/method/backend" entries of `out_var`.
+function(row_keys json out_var)
+  string(JSON rows LENGTH "${json}" rows)
+  set(keys "")
+  if(rows GREATER 0)
+    math(EXPR last "${rows} - 1")
+    foreach(i RANGE ${last})
+      string(JSON mesh GET "${json}" rows ${i} mesh)
+      string(JSON method GET "${json}" rows ${i} method)
+      string(JSON backend GET "${json}" rows ${i} sdf_backend)
+      list(APPEND keys "${mesh}/${method}/${backend}")
+    endforeach()
+  endif()
+  set(${out_var} "${keys}" PARENT_SCOPE)
+endfunction()
+
+if(PART STREQUAL "vulkan")
+  # A. Both backends on the same placements: one row per SDF method and backend, finite figures.
+  execute_process(COMMAND "${BENCH}" --embedded-only --placements 3 --seed 2 --methods
+    paper,physics-mesh --sdf-backend cpu,vulkan --json "${WORK}/vk.json"
+    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(rc EQUAL 3 AND err MATCHES "no Vulkan device")
+    message(STATUS "SDFG_SKIPPED: no Vulkan device for --sdf-backend vulkan")
+    return()
+  endif()
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "--sdf-backend cpu,vulkan exited ${rc}\n${out}\n${err}")
+  endif()
+  file(READ "${WORK}/vk.json" json)
+  row_keys("${json}" keys)
+  foreach(mesh mug torus thin-plate)
+    foreach(key "${mesh}/paper/cpu" "${mesh}/paper/vulkan" "${mesh}/physics-mesh/none")
+      if(NOT key IN_LIST keys)
+        message(FATAL_ERROR "no row ${key}; rows: ${keys}")
+      endif()
+    endforeach()
+  endforeach()
+  list(LENGTH keys n)
+  if(NOT n EQUAL 9)
+    message(FATAL_ERROR "expected 9 rows (3 objects x paper/cpu, paper/vulkan, physics), got ${keys}")
+  endif()
+  check_rows("${json}" 3)
+  # The text tables tell the rows apart by backend.
+  if(NOT out MATCHES "\nsdf build \\(ms\\) +vulkan +[0-9.]+" OR NOT out MATCHES "\npaper +vulkan +[0-9.]+")
+    message(FATAL_ERROR "the text tables show no vulkan rows:\n${out}")
+  endif()
+
+  # B. The quick sweep prints the CPU and Vulkan columns side by side, with numbers in both.
+  execute_process(COMMAND "${BENCH}" --embedded-only --placements 1 --methods paper
+    --scaling-quick RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "--scaling-quick exited ${rc}\n${out}\n${err}")
+  endif()
+  string(FIND "${out}" "| CPU build (ms) | Vulkan build (ms) | CPU / Vulkan |" at)
+  if(at EQUAL -1)
+    message(FATAL_ERROR "--scaling-quick lacks the CPU and Vulkan columns:\n${out}")
+  endif()
+  set(num "[0-9][0-9.e+-]*")
+  string(REGEX MATCHALL "\n\\| torus-[0-9]+ \\| [0-9,]+ \\| ${num} \\| ${num} \\| ${num} \\| ${num} \\|" sweep "${out}")
+  list(LENGTH sweep n)
+  if(n LESS 3)
+    message(FATAL_ERROR "expected 3 sweep rows with CPU and Vulkan times, found ${n}:\n${out}")
+  endif()
+  message(STATUS "autograsp-bench Vulkan backend checks passed")
+  return()
+endif()
 
 # 1. A short run over the embedded objects.
 execute_process(COMMAND "${BENCH}" --embedded-only --placements 5 --seed 3 --json "${WORK}/out.json"
@@ -70,10 +148,7 @@ string(JSON rows LENGTH "${json}" rows)
 if(rows LESS 3)
   message(FATAL_ERROR "only ${rows} rows for three embedded objects")
 endif()
-math(EXPR last "${rows} - 1")
-foreach(i RANGE ${last})
-  check_row("${json}" ${i} 5)
-endforeach()
+check_rows("${json}" 5)
 if(NOT out MATCHES "Solve time per grasp" OR NOT out MATCHES "Quality")
   message(FATAL_ERROR "tables missing from the output:\n${out}")
 endif()
@@ -102,10 +177,31 @@ endif()
 check_row("${json}" 0 3)
 
 # 3. Bad option values are usage errors.
-foreach(args "--placements;abc" "--methods;nope" "--resolution;1" "--da;0" "--bogus")
+foreach(args "--placements;abc" "--methods;nope" "--resolution;1" "--da;0" "--bogus"
+    "--sdf-backend;gpu" "--sdf-backend;,")
   execute_process(COMMAND "${BENCH}" ${args} RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
   if(NOT rc EQUAL 2 OR NOT err MATCHES "usage")
     message(FATAL_ERROR "\"${args}\" exited ${rc}, expected 2 with usage:\n${err}")
   endif()
 endforeach()
+execute_process(COMMAND "${BENCH}" --sdf-backend cpu,gpu RESULT_VARIABLE rc OUTPUT_QUIET
+  ERROR_VARIABLE err)
+if(NOT err MATCHES "unknown backend \"gpu\"")
+  message(FATAL_ERROR "a bad backend name is not named:\n${err}")
+endif()
+
+# 4. No Vulkan device (the loader pointed at no driver): the vulkan rows are left out, not
+# faked, stderr says why, and the exit code is 3; the cpu and physics rows are all there.
+execute_process(COMMAND "${CMAKE_COMMAND}" -E env "VK_ICD_FILENAMES=${WORK}/no-driver.json"
+  "VK_DRIVER_FILES=${WORK}/no-driver.json" "${BENCH}" --embedded-only --placements 2
+  --methods paper,physics-mesh --sdf-backend cpu,vulkan --json "${WORK}/novk.json"
+  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 3 OR NOT err MATCHES "vulkan: no Vulkan device")
+  message(FATAL_ERROR "no device: exit ${rc} (expected 3), stderr:\n${err}")
+endif()
+file(READ "${WORK}/novk.json" json)
+row_keys("${json}" keys)
+if(NOT keys STREQUAL "mug/paper/cpu;mug/physics-mesh/none;torus/paper/cpu;torus/physics-mesh/none;thin-plate/paper/cpu;thin-plate/physics-mesh/none")
+  message(FATAL_ERROR "no device: unexpected rows ${keys}")
+endif()
 message(STATUS "autograsp-bench CLI checks passed")

@@ -10,8 +10,10 @@ endif()
 file(REMOVE_RECURSE "${WORK}")
 set(dir "${WORK}/report")
 
+# CPU only: the report's mechanics, the same on every machine (the Vulkan columns are checked by
+# bench_cli_vulkan).
 execute_process(COMMAND "${BENCH}" --embedded-only --placements 5 --threads 2 --scaling-quick
-  --report "${dir}" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  --sdf-backend cpu --report "${dir}" --scaling-json "${WORK}/scaling.json" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "report run exited ${rc}\n${out}\n${err}")
 endif()
@@ -53,7 +55,7 @@ foreach(mesh mug torus thin-plate)
     message(FATAL_ERROR "no quality row for ${mesh} / paper with 5 grasps:\n${md}")
   endif()
 endforeach()
-string(REGEX MATCHALL "\n\\| sphere-[0-9]+ \\| [0-9,]+ \\| [0-9.e+-]+ \\| [0-9.e+-]+ \\|" sweep "${md}")
+string(REGEX MATCHALL "\n\\| torus-[0-9]+ \\| [0-9,]+ \\| [0-9.e+-]+ \\| [0-9.e+-]+ \\|" sweep "${md}")
 list(LENGTH sweep n)
 if(n LESS 3)
   message(FATAL_ERROR "expected 3 rows of SDF build time against triangles, found ${n}:\n${md}")
@@ -89,7 +91,8 @@ else()
     message(FATAL_ERROR "no gnuplot, and benchmarks.md does not say so")
   endif()
 endif()
-# The same results reported again from their JSON, without solving: the quality table is the same.
+# The same results reported again from their JSON, without solving or sweeping: the quality table
+# is the same.
 file(GLOB results "${dir}/bench-data/*.json")
 list(LENGTH results n)
 if(NOT n EQUAL 1)
@@ -97,8 +100,8 @@ if(NOT n EQUAL 1)
 endif()
 set(again "${WORK}/report-again")
 file(REMOVE_RECURSE "${again}")
-execute_process(COMMAND "${BENCH}" --report-from ${results} --report "${again}" --scaling-quick
-                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+execute_process(COMMAND "${BENCH}" --report-from ${results} --report "${again}"
+                --scaling-from "${WORK}/scaling.json" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0 OR NOT EXISTS "${again}/benchmarks.md")
   message(FATAL_ERROR "--report-from exited ${rc}\n${out}\n${err}")
 endif()
@@ -107,6 +110,12 @@ string(REGEX MATCH "\n\\| mug \\| paper \\|[^\n]*" row1 "${md}")
 string(REGEX MATCH "\n\\| mug \\| paper \\|[^\n]*" row2 "${md2}")
 if(row1 STREQUAL "" OR NOT row1 STREQUAL row2)
   message(FATAL_ERROR "quality rows differ between the run and --report-from:\n${row1}\n${row2}")
+endif()
+# ... and the sweep read back from its JSON (--scaling-from) renders the same tables.
+string(REGEX MATCH "### SDF build time against triangle count.*### SDF build time against grid resolution[^#]*" sweep1 "${md}")
+string(REGEX MATCH "### SDF build time against triangle count.*### SDF build time against grid resolution[^#]*" sweep2 "${md2}")
+if(sweep1 STREQUAL "" OR NOT sweep1 STREQUAL sweep2)
+  message(FATAL_ERROR "the sweep differs after --scaling-from:\n${sweep1}\n---\n${sweep2}")
 endif()
 execute_process(COMMAND "${BENCH}" --report-from "${WORK}/missing.json" --report "${again}"
                 RESULT_VARIABLE rc ERROR_VARIABLE err)

@@ -88,7 +88,7 @@ set datafile missing 'NaN'
 set grid ytics lc rgb '#dddddd'
 set border 3
 set tics nomirror
-set xrange [914.286:999760]
+set xrange [3291.43:999760]
 set output '../img/bench/sdf_build_triangles.png'
 set title 'Grab-box SDF build time against triangle count (16^3 nodes)'
 set xlabel 'triangles (log scale)'
@@ -98,17 +98,17 @@ set logscale x
 set format x '%.0s%c'
 set key left top
 set grid xtics lc rgb '#dddddd'
-plot 'sdf_build_triangles.dat' using 2:3 with linespoints lw 2 pt 7 title 'CPU', 'sdf_build_triangles.dat' using 2:(int($0) % 2 == 0 ? $3 : NaN):1 with labels offset 0,1 font 'sans,8' notitle, 'sdf_build_triangles.dat' using 2:(int($0) % 2 == 1 ? $3 : NaN):1 with labels offset 0,-1 font 'sans,8' notitle
+plot 'sdf_build_triangles.dat' using 2:3 with linespoints lw 2 pt 7 title 'CPU build', 'sdf_build_triangles.dat' using 2:4 with linespoints lw 2 pt 7 title 'Vulkan build', 'sdf_build_triangles.dat' using 2:5 with linespoints lw 2 pt 7 title 'CPU build + sampling', 'sdf_build_triangles.dat' using 2:6 with linespoints lw 2 pt 7 title 'Vulkan build + sampling', 'sdf_build_triangles.dat' using 2:(int($0) % 2 == 0 ? $3 : NaN):1 with labels offset 0,1 font 'sans,8' notitle, 'sdf_build_triangles.dat' using 2:(int($0) % 2 == 1 ? $3 : NaN):1 with labels offset 0,-1 font 'sans,8' notitle
 reset
 set terminal pngcairo size 1000,520 noenhanced font 'sans,10'
 set datafile missing 'NaN'
 set grid ytics lc rgb '#dddddd'
 set border 3
 set tics nomirror
-set xtics (16, 24, 32, 48, 64)
+set xtics (16, 32, 64)
 set xrange [11.4286:89.6]
 set output '../img/bench/sdf_build_resolution.png'
-set title 'Grab-box SDF build time against resolution (stanford-bunny, 69,451 triangles)'
+set title 'Grab-box SDF build time against resolution (torus-99856, 99,856 triangles)'
 set xlabel 'grid nodes per axis (log scale)'
 set ylabel 'build time per grab (ms)'
 set logscale y
@@ -116,4 +116,4 @@ set logscale x
 set format x '%.0s%c'
 set key left top
 set grid xtics lc rgb '#dddddd'
-plot 'sdf_build_resolution.dat' using 2:3 with linespoints lw 2 pt 7 title 'CPU'
+plot 'sdf_build_resolution.dat' using 2:3 with linespoints lw 2 pt 7 title 'CPU build', 'sdf_build_resolution.dat' using 2:4 with linespoints lw 2 pt 7 title 'Vulkan build', 'sdf_build_resolution.dat' using 2:5 with linespoints lw 2 pt 7 title 'CPU build + sampling', 'sdf_build_resolution.dat' using 2:6 with linespoints lw 2 pt 7 title 'Vulkan build + sampling'

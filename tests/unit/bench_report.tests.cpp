@@ -88,6 +88,44 @@ TEST_CASE("The report renders every JSON metric, known or not", "[bench][report]
   }
 }
 
+TEST_CASE("Rows of one method on two SDF backends get a backend column", "[bench][report]") {
+  const fs::path dir = scratch("backends");
+  const fs::path json = dir / "in.json";
+  std::ofstream(json) << R"({"placements": 2, "rows": [
+    {"mesh": "cube", "triangles": 12, "method": "paper", "sdf_backend": "cpu", "grasps": 2,
+     "sdf_build_ms": {"median": 1.5}, "solve_us": {"median": 2.25}, "pass_through": 3},
+    {"mesh": "cube", "triangles": 12, "method": "paper", "sdf_backend": "vulkan", "grasps": 2,
+     "sdf_build_ms": {"median": 40}, "solve_us": {"median": 2.5}, "pass_through": 4},
+    {"mesh": "cube", "triangles": 12, "method": "physics-mesh", "sdf_backend": "none",
+     "grasps": 2, "sdf_build_ms": {"median": null}, "solve_us": {"median": 90},
+     "pass_through": 1}]})";
+  sdfg::bench::ReportRequest request;
+  request.dir = dir / "out";
+  request.resultsJson = json;
+  REQUIRE_FALSE(sdfg::bench::writeReport(request, nullptr).has_value());
+  const std::string md = readAll(request.dir / "benchmarks.md");
+  REQUIRE_FALSE(md.empty());
+
+  SECTION("the speed table: one row per method and backend, one build row per backend") {
+    CHECK(md.find("| method | SDF backend | cube |") != std::string::npos);
+    CHECK(md.find("| paper | cpu | 2.25 |") != std::string::npos);
+    CHECK(md.find("| paper | vulkan | 2.5 |") != std::string::npos);
+    CHECK(md.find("| physics-mesh | none | 90 |") != std::string::npos);
+    CHECK(md.find("| SDF build (ms) | cpu | 1.5 |") != std::string::npos);
+    CHECK(md.find("| SDF build (ms) | vulkan | 40 |") != std::string::npos);
+  }
+  SECTION("the quality table keeps both rows apart") {
+    CHECK(md.find("| mesh | method | SDF backend | grasps | pass_through |") != std::string::npos);
+    CHECK(md.find("| cube | paper | cpu | 2 | 3 |") != std::string::npos);
+    CHECK(md.find("| cube | paper | vulkan | 2 | 4 |") != std::string::npos);
+  }
+  SECTION("the figures name the backend of each bar") {
+    const std::string dat = readAll(request.dir / "bench-data" / "pass_through.dat");
+    CHECK(dat.find("\"paper (cpu)\" \"paper (vulkan)\" \"physics-mesh\"") != std::string::npos);
+    CHECK(dat.find("\"cube\" 3 4 1") != std::string::npos);
+  }
+}
+
 TEST_CASE("A broken or missing JSON is an error naming the file", "[bench][report]") {
   const fs::path dir = scratch("broken");
   sdfg::bench::ReportRequest request;

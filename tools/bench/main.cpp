@@ -35,7 +35,7 @@
 #include "mesh_io.h"
 #include "placements.h"
 #include "report.h"
-#include "sdf_cpu.h"
+#include "sdf_backends.h"
 #include "sdf_grid.h"
 #include "shapes.h"
 #include "solver.h"
@@ -49,6 +49,8 @@ namespace {
 constexpr float kHandSizeDiagonal = 0.18f;  // metres: every object is scaled to this bbox diagonal
 constexpr double kSolveBatchTargetUs = 50.0;  // a timed batch lasts at least this long
 constexpr int kSolveRepeats = 3;              // per-solve time = min over this many batches
+// Exit code of a run that completed without a backend it was asked for (no Vulkan device).
+constexpr int kExitBackendUnavailable = 3;
 
 const char* kUsage =
     "usage: autograsp-bench [options]\n"
@@ -62,16 +64,25 @@ const char* kUsage =
     "  --da X             curl step of the solvers, in (0, 1] (default 0.1)\n"
     "  --resolution N     SDF grid nodes per axis, 2..128 (default 16)\n"
     "  --threads N        worker threads for SDF builds and grading (default: all cores)\n"
+    "  --sdf-backend LIST comma-separated SDF builders: cpu, vulkan (default cpu); each SDF\n"
+    "                     method gets one row per backend, solving on that backend's field.\n"
+    "                     vulkan: a device of its own (VK_ICD_FILENAMES picks the driver)\n"
     "  --thin-plate-set   only the embedded thin plate, graded on the placements where\n"
     "                     \"paper\" (added if missing; --da must be 0.1) passes through it\n"
     "  --json FILE        write the results as JSON\n"
     "  --report DIR       also write DIR/benchmarks.md with tables and plots (gnuplot) of this\n"
     "                     run, DIR/img/bench/*.png and DIR/bench-data/; implies --scaling\n"
-    "  --scaling          also time the CPU SDF build against triangles and resolution\n"
-    "  --scaling-quick    --scaling on small spheres only (tests)\n"
+    "  --scaling          also time the SDF builds against triangles and resolution, the\n"
+    "                     --sdf-backend list side by side (default: cpu and vulkan)\n"
+    "  --scaling-quick    --scaling on small tori only (tests)\n"
+    "  --scaling-json FILE also write the sweep's figures as JSON; implies --scaling\n"
+    "  --scaling-from FILE the sweep's figures from a JSON --scaling-json wrote, instead of\n"
+    "                     sweeping again\n"
     "  --report-from FILE with --report: write the report from a JSON an earlier run wrote\n"
     "                     (with --json) instead of running the meshes again\n"
-    "  --help             this text\n";
+    "  --help             this text\n"
+    "exit codes: 0 done; 1 a mesh, solve or output failed; 2 bad option; 3 done, but a\n"
+    "requested SDF backend (vulkan) had no device: its rows and columns are left out\n";
 
 struct Options {
   std::vector<std::string> meshes;
@@ -84,8 +95,12 @@ struct Options {
   float da = 0.1f;
   int resolution = 16;
   unsigned threads = 0;
+  std::vector<std::string> sdfBackends = {tools::kCpuBackend};
+  bool sdfBackendsGiven = false;  // else --scaling compares cpu and vulkan
   std::string json;
   std::string report;
+  std::string scalingJson;  // the sweep's figures as JSON
+  std::string scalingFrom;  // a sweep's JSON to report instead of sweeping again
   bool scaling = false;
   bool scalingQuick = false;
   std::string reportFrom;  // a results JSON to report on instead of running
@@ -127,6 +142,32 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
       out = *v;
       return std::nullopt;
     };
+    // A value that must not be empty (a file or folder).
+    auto needName = [&](std::string& out, const char* what) -> std::optional<UsageError> {
+      if (auto e = needValue(out)) return e;
+      if (out.empty()) return UsageError{arg + ": empty " + what};
+      return std::nullopt;
+    };
+    // A comma-separated list of names from `names`, each kept once, in order.
+    auto needList = [&](const std::vector<std::string>& names, const std::string& what,
+                        std::vector<std::string>& out) -> std::optional<UsageError> {
+      std::string text;
+      if (auto e = needValue(text)) return e;
+      out.clear();
+      std::stringstream ss(text);
+      std::string item;
+      while (std::getline(ss, item, ',')) {
+        if (item.empty()) continue;
+        if (std::find(names.begin(), names.end(), item) == names.end()) {
+          std::string list;
+          for (const auto& k : names) list += (list.empty() ? "" : ", ") + k;
+          return UsageError{arg + ": unknown " + what + " \"" + item + "\"; known: " + list};
+        }
+        if (std::find(out.begin(), out.end(), item) == out.end()) out.push_back(item);
+      }
+      if (out.empty()) return UsageError{arg + ": no " + what + " given"};
+      return std::nullopt;
+    };
     std::string v;
     long long n = 0;
     if (arg == "--help" || arg == "-h") {
@@ -155,22 +196,7 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
       }
       o.seed = s;
     } else if (arg == "--methods") {
-      if (auto e = needValue(v)) return e;
-      o.methods.clear();
-      std::stringstream ss(v);
-      std::string m;
-      while (std::getline(ss, m, ',')) {
-        if (m.empty()) continue;
-        if (std::find(known.begin(), known.end(), m) == known.end()) {
-          std::string list;
-          for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-          return UsageError{"--methods: unknown method \"" + m + "\"; known: " + list};
-        }
-        if (std::find(o.methods.begin(), o.methods.end(), m) == o.methods.end()) {
-          o.methods.push_back(m);
-        }
-      }
-      if (o.methods.empty()) return UsageError{"--methods: no method given"};
+      if (auto e = needList(known, "method", o.methods)) return e;
     } else if (arg == "--da") {
       if (auto e = needValue(v)) return e;
       char* end = nullptr;
@@ -189,19 +215,25 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
       if (auto e = needValue(v)) return e;
       if (!parseInt(v, 0, 1024, n)) return UsageError{"--threads: \"" + v + "\" is not 0..1024"};
       o.threads = unsigned(n);
+    } else if (arg == "--sdf-backend") {
+      if (auto e =
+              needList({tools::kCpuBackend, tools::kVulkanBackend}, "backend", o.sdfBackends)) {
+        return e;
+      }
+      o.sdfBackendsGiven = true;
     } else if (arg == "--json") {
-      if (auto e = needValue(v)) return e;
-      if (v.empty()) return UsageError{"--json: empty file name"};
-      o.json = v;
+      if (auto e = needName(o.json, "file name")) return e;
     } else if (arg == "--report") {
-      if (auto e = needValue(v)) return e;
-      if (v.empty()) return UsageError{"--report: empty folder name"};
-      o.report = v;
+      if (auto e = needName(o.report, "folder name")) return e;
+      o.scaling = true;
+    } else if (arg == "--scaling-json") {
+      if (auto e = needName(o.scalingJson, "file name")) return e;
+      o.scaling = true;
+    } else if (arg == "--scaling-from") {
+      if (auto e = needName(o.scalingFrom, "file name")) return e;
       o.scaling = true;
     } else if (arg == "--report-from") {
-      if (auto e = needValue(v)) return e;
-      if (v.empty()) return UsageError{"--report-from: empty file name"};
-      o.reportFrom = v;
+      if (auto e = needName(o.reportFrom, "file name")) return e;
     } else if (arg == "--scaling" || arg == "--scaling-quick") {
       o.scaling = true;
       o.scalingQuick = o.scalingQuick || arg == "--scaling-quick";
@@ -239,6 +271,7 @@ struct Row {
   size_t triangles = 0;
   std::string method;
   bool usesField = false;
+  std::string backend = "none";  // the SDF builder whose field the method read
   int grasps = 0;
   int failedSolves = 0;
   std::vector<double> sdfBuildMs;
@@ -367,10 +400,13 @@ struct PhaseSeconds {
   double grade = 0.0;  // evaluation against the exact mesh
 };
 
-// Returns the rows of this mesh, or an error naming what failed.
+// Returns the rows of this mesh, or an error naming what failed: one row per physics method, one
+// per SDF method and builder (every builder builds the field of every placement; the SDF methods
+// solve on each in turn).
 Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& original,
                                  const Options& o, const HandModel& hand, const GridBox& box,
-                                 CpuSdfBuilder& builder, unsigned threads, const Progress& progress,
+                                 const std::vector<tools::TimedSdfBuilder*>& builders,
+                                 unsigned threads, const Progress& progress,
                                  PhaseSeconds& phaseSeconds) {
   if (auto error = validateMesh(original.positions, original.indices)) {
     return makeError(error->code, error->message);
@@ -405,6 +441,12 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
     anyField = anyField || method.solver->needsField();
     methods.push_back(std::move(method));
   }
+  anyField = anyField && !builders.empty();
+  for (tools::TimedSdfBuilder* b : builders) {
+    if (Status s = b->prepare(mesh, **distance); s != Status::ok) {
+      return makeError(s, b->name() + " SDF builder: cannot take the mesh");
+    }
+  }
 
   auto now = [] { return std::chrono::steady_clock::now(); };
   const auto startedAt = now();
@@ -421,54 +463,74 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
                  name.c_str(), placements.size(), o.placements);
   }
 
-  std::vector<Row> rows(methods.size());
+  // One row per method and field: rowMethod[r] is its method, rowBuilder[r] its builder (or -1).
+  std::vector<Row> rows;
+  std::vector<size_t> rowMethod;
+  std::vector<int> rowBuilder;
   for (size_t m = 0; m < methods.size(); ++m) {
-    rows[m].mesh = name;
-    rows[m].triangles = mesh.triangleCount();
-    rows[m].method = methods[m].name;
-    rows[m].usesField = methods[m].solver->needsField();
+    Row row;
+    row.mesh = name;
+    row.triangles = mesh.triangleCount();
+    row.method = methods[m].name;
+    row.usesField = methods[m].solver->needsField();
+    if (!row.usesField) {
+      rows.push_back(row);
+      rowMethod.push_back(m);
+      rowBuilder.push_back(-1);
+    }
+    for (size_t b = 0; row.usesField && b < builders.size(); ++b) {
+      row.backend = builders[b]->name();
+      rows.push_back(row);
+      rowMethod.push_back(m);
+      rowBuilder.push_back(int(b));
+    }
   }
-  // results[m][p]; solved[m][p] says whether the solve succeeded.
-  std::vector<std::vector<GraspResult>> results(methods.size(),
+  // results[r][p]; solved[r][p] says whether the solve succeeded.
+  std::vector<std::vector<GraspResult>> results(rows.size(),
                                                 std::vector<GraspResult>(placements.size()));
-  std::vector<std::vector<char>> solved(methods.size(), std::vector<char>(placements.size(), 0));
+  std::vector<std::vector<char>> solved(rows.size(), std::vector<char>(placements.size(), 0));
   std::optional<Error> firstFailure;
 
-  SdfGrid grid(box);
+  std::vector<SdfGrid> grids(builders.size(), SdfGrid(box));
   for (size_t p = 0; p < placements.size(); ++p) {
     progress.show(name, "solve", p, placements.size());
     const Placement& placement = placements[p];
-    GraspScene scene;
-    scene.objectFromHand = placement.objectFromHand;
-    if (anyField) {
+    std::vector<double> buildMs(builders.size(), std::nan(""));
+    for (size_t b = 0; anyField && b < builders.size(); ++b) {
       const auto t0 = now();
-      const Status s = builder.build(**distance, placement.objectFromHand, box, grid);
-      const double ms = std::chrono::duration<double, std::milli>(now() - t0).count();
-      if (s != Status::ok) return makeError(s, "CPU SDF build failed");
-      for (size_t m = 0; m < methods.size(); ++m) {
-        if (rows[m].usesField) rows[m].sdfBuildMs.push_back(ms);
-      }
-      scene.field = &grid;
-    }
-    for (size_t m = 0; m < methods.size(); ++m) {
-      scene.collider = methods[m].collider.get();
-      Status s = Status::ok;
-      const double us = timeSolveUs(*methods[m].solver, scene, results[m][p], s, now);
+      const Status s = builders[b]->build(placement.objectFromHand, box, grids[b]);
+      buildMs[b] = std::chrono::duration<double, std::milli>(now() - t0).count();
       if (s != Status::ok) {
-        rows[m].failedSolves++;
+        return makeError(s, builders[b]->name() + " SDF build failed on placement " +
+                                std::to_string(p) + " (" + toString(s) + ")");
+      }
+    }
+    for (size_t r = 0; r < rows.size(); ++r) {
+      const Method& method = methods[rowMethod[r]];
+      GraspScene scene;
+      scene.objectFromHand = placement.objectFromHand;
+      scene.collider = method.collider.get();
+      if (rowBuilder[r] >= 0) {
+        scene.field = &grids[size_t(rowBuilder[r])];
+        rows[r].sdfBuildMs.push_back(buildMs[size_t(rowBuilder[r])]);
+      }
+      Status s = Status::ok;
+      const double us = timeSolveUs(*method.solver, scene, results[r][p], s, now);
+      if (s != Status::ok) {
+        rows[r].failedSolves++;
         if (!firstFailure) {
-          firstFailure = makeError(s, methods[m].name + ": solve failed on placement " +
+          firstFailure = makeError(s, method.name + ": solve failed on placement " +
                                           std::to_string(p) + " (" + toString(s) + ")");
         }
         continue;
       }
-      solved[m][p] = 1;
-      rows[m].solveUs.push_back(us);
+      solved[r][p] = 1;
+      rows[r].solveUs.push_back(us);
     }
   }
 
   const auto solvedAt = now();
-  std::vector<GraspMetrics> metrics(methods.size() * placements.size());
+  std::vector<GraspMetrics> metrics(rows.size() * placements.size());
   std::atomic<size_t> graded{0};
   parallelFor(metrics.size(), threads, [&](size_t i) {
     const size_t m = i / placements.size(), p = i % placements.size();
@@ -485,11 +547,12 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
   // The thin-plate set: only the placements where "paper" went through the plate.
   std::vector<char> selected(placements.size(), 1);
   if (o.thinPlateSet) {
+    // "paper" on the first backend's field decides.
     size_t paper = 0;
-    while (paper < methods.size() && methods[paper].name != "paper") ++paper;
+    while (paper < rows.size() && rows[paper].method != "paper") ++paper;
     size_t count = 0;
     for (size_t p = 0; p < placements.size(); ++p) {
-      selected[p] = paper < methods.size() && solved[paper][p] &&
+      selected[p] = paper < rows.size() && solved[paper][p] &&
                     metrics[paper * placements.size() + p].passThroughs > 0;
       count += selected[p] ? 1 : 0;
     }
@@ -497,7 +560,7 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
                  count, placements.size());
     for (Row& row : rows) row.mesh = name + "/paper-skips";
   }
-  for (size_t m = 0; m < methods.size(); ++m) {
+  for (size_t m = 0; m < rows.size(); ++m) {
     Row& row = rows[m];
     for (size_t p = 0; p < placements.size(); ++p) {
       if (!solved[m][p] || !selected[p]) continue;
@@ -526,51 +589,15 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
 // ---------------------------------------------------------------------------------------------
 // Output
 
-std::string jsonString(const std::string& s) {
-  std::string out = "\"";
-  for (unsigned char c : s) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (c < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
-        } else {
-          out += char(c);
-        }
-    }
-  }
-  return out + "\"";
-}
-
-std::string jsonNumber(double v) {
-  if (!std::isfinite(v)) return "null";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
 // Per-finger counts, thumb to little.
 std::string jsonCounts(const std::array<long long, kFingerCount>& counts) {
   std::string out = "[";
   for (int f = 0; f < kFingerCount; ++f) out += (f ? ", " : "") + std::to_string(counts[f]);
   return out + "]";
 }
+
+using bench::jsonNumber;
+using bench::jsonString;
 
 bool writeJson(const std::string& file, const Options& o, const std::vector<Row>& rows) {
   std::ofstream out(file);
@@ -585,8 +612,7 @@ bool writeJson(const std::string& file, const Options& o, const std::vector<Row>
     const double buildP95 = r.usesField ? percentile(r.sdfBuildMs, 0.95) : nan;
     out << (i ? ",\n" : "\n") << "    {\"mesh\": " << jsonString(r.mesh)
         << ", \"triangles\": " << r.triangles << ", \"method\": " << jsonString(r.method)
-        << ", \"sdf_backend\": " << jsonString(r.usesField ? "cpu" : "none")
-        << ", \"grasps\": " << r.grasps
+        << ", \"sdf_backend\": " << jsonString(r.backend) << ", \"grasps\": " << r.grasps
         << ",\n     \"sdf_build_ms\": {\"median\": " << jsonNumber(buildMedian)
         << ", \"p95\": " << jsonNumber(buildP95) << "}"
         << ", \"solve_us\": {\"median\": " << jsonNumber(percentile(r.solveUs, 0.5))
@@ -618,69 +644,92 @@ std::string fmt(double v, const char* format = "%.3g") {
 }
 
 void printTables(const Options& o, const std::vector<Row>& rows) {
-  std::vector<std::string> meshes;
+  // Rows are told apart by mesh, method and backend; the backend is shown when more than one ran.
+  std::vector<std::string> meshes, backends;
+  std::vector<std::pair<std::string, std::string>> variants;  // method, backend
   for (const Row& r : rows) {
     if (std::find(meshes.begin(), meshes.end(), r.mesh) == meshes.end()) meshes.push_back(r.mesh);
+    const std::pair<std::string, std::string> v{r.method, r.backend};
+    if (std::find(variants.begin(), variants.end(), v) == variants.end()) variants.push_back(v);
+    if (r.usesField && std::find(backends.begin(), backends.end(), r.backend) == backends.end()) {
+      backends.push_back(r.backend);
+    }
   }
-  auto find = [&](const std::string& mesh, const std::string& method) -> const Row* {
+  const bool showBackend = backends.size() > 1;
+  auto find = [&](const std::string& mesh, const std::string& method,
+                  const std::string& backend) -> const Row* {
     for (const Row& r : rows) {
-      if (r.mesh == mesh && r.method == method) return &r;
+      if (r.mesh == mesh && r.method == method && r.backend == backend) return &r;
     }
     return nullptr;
   };
   size_t width = 10;
   for (const auto& m : meshes) width = std::max(width, m.size() + 1);
+  const int methodWidth = showBackend ? 15 : 22;
+  auto methodCells = [&](const std::string& method, const std::string& backend) {
+    std::printf("%-*s", methodWidth, method.c_str());
+    if (showBackend) std::printf(" %-6s", backend.c_str());
+  };
 
   std::printf(
       "\nSolve time per grasp, median of %d placements, microseconds (paper Table 1: "
       "ms; SDF build not included)\n",
       o.placements);
-  std::printf("%-22s", "method");
+  methodCells("method", "sdf");
   for (const auto& m : meshes) std::printf(" %*s", int(width), m.c_str());
   std::printf("\n");
-  for (const auto& method : o.methods) {
-    std::printf("%-22s", method.c_str());
+  for (const auto& [method, backend] : variants) {
+    methodCells(method, backend);
     for (const auto& m : meshes) {
-      const Row* r = find(m, method);
+      const Row* r = find(m, method, backend);
       std::printf(" %*s", int(width), r ? fmt(percentile(r->solveUs, 0.5), "%.2f").c_str() : "-");
     }
     std::printf("\n");
   }
-  std::printf("%-22s", "cpu sdf build (ms)");
-  for (const auto& m : meshes) {
-    std::string cell = "-";
-    for (const auto& method : o.methods) {
-      const Row* r = find(m, method);
-      if (r && r->usesField) {
-        cell = fmt(percentile(r->sdfBuildMs, 0.5), "%.2f");
-        break;
+  for (const auto& backend : backends) {
+    methodCells(showBackend ? "sdf build (ms)" : backend + " sdf build (ms)", backend);
+    for (const auto& m : meshes) {
+      std::string cell = "-";
+      for (const auto& [method, b] : variants) {
+        const Row* r = b == backend ? find(m, method, b) : nullptr;
+        if (r && r->usesField) {
+          cell = fmt(percentile(r->sdfBuildMs, 0.5), "%.2f");
+          break;
+        }
       }
+      std::printf(" %*s", int(width), cell.c_str());
     }
-    std::printf(" %*s", int(width), cell.c_str());
+    std::printf("\n");
   }
-  std::printf("\n%-22s", "triangles");
+  methodCells("triangles", "");
   for (const auto& m : meshes) {
-    const Row* r = find(m, o.methods.front());
-    std::printf(" %*zu", int(width), r ? r->triangles : size_t(0));
+    size_t triangles = 0;
+    for (const Row& r : rows) {
+      if (r.mesh == m && triangles == 0) triangles = r.triangles;
+    }
+    std::printf(" %*zu", int(width), triangles);
   }
   std::printf(
       "\n\nQuality against the exact mesh (tip residual over fingers in contact; "
       "penetration over grasps)\n");
-  std::printf("%-24s %-16s %6s %9s %9s %9s %9s %9s %9s %7s %8s %6s %5s\n", "mesh", "method",
-              "grasps", "tip_med", "tip_p95", "cres_med", "cres_p95", "pen_p99", "pen_max", "early",
-              "contacts", "tip%", "pass");
+  std::printf("%-24s %-16s", "mesh", "method");
+  if (showBackend) std::printf(" %-6s", "sdf");
+  std::printf(" %6s %9s %9s %9s %9s %9s %9s %7s %8s %6s %5s\n", "grasps", "tip_med", "tip_p95",
+              "cres_med", "cres_p95", "pen_p99", "pen_max", "early", "contacts", "tip%", "pass");
   for (const auto& m : meshes) {
-    for (const auto& method : o.methods) {
-      const Row* r = find(m, method);
+    for (const auto& [method, backend] : variants) {
+      const Row* r = find(m, method, backend);
       if (!r) continue;
       long long inContact = 0, tipContact = 0;
       for (int f = 0; f < kFingerCount; ++f) {
         inContact += r->contactFingers[f];
         tipContact += r->tipContactFingers[f];
       }
+      std::printf("%-24s %-16s", m.c_str(), method.c_str());
+      if (showBackend) std::printf(" %-6s", backend.c_str());
       std::printf(
-          "%-24s %-16s %6d %9s %9s %9s %9s %9s %9s %7d %8s %6s %5lld\n", m.c_str(), method.c_str(),
-          r->grasps, fmt(percentile(r->tipResidualMm, 0.5)).c_str(),
+          " %6d %9s %9s %9s %9s %9s %9s %7d %8s %6s %5lld\n", r->grasps,
+          fmt(percentile(r->tipResidualMm, 0.5)).c_str(),
           fmt(percentile(r->tipResidualMm, 0.95)).c_str(),
           fmt(percentile(r->contactResidualMm, 0.5)).c_str(),
           fmt(percentile(r->contactResidualMm, 0.95)).c_str(),
@@ -695,25 +744,30 @@ void printTables(const Options& o, const std::vector<Row>& rows) {
       "(mm; tip = |tip gap| and cres = |closest phalanx sphere gap|, over fingers in contact; "
       "early = fingers stopped > 5 mm short of a reachable pose; contacts = fingers within 2 mm, "
       "mean per grasp; tip%% = fingers in contact whose tip is the closest sphere; pass = fingers "
-      "whose closing sweep put a sphere centre inside the mesh)\n");
+      "whose closing sweep put a sphere centre inside the mesh%s)\n",
+      showBackend ? "; sdf = the backend that built the field the method read" : "");
 
+  // Against "paper" on the same placements and, for the SDF methods, the same backend's field.
   const std::string base = "paper";
   if (std::find(o.methods.begin(), o.methods.end(), base) == o.methods.end()) return;
   std::printf("\nRatios against \"paper\", same placements (solve time x; early stops x)\n");
-  std::printf("%-24s %-16s %10s %12s\n", "mesh", "method", "solve", "early stops");
+  std::printf("%-24s %-16s", "mesh", "method");
+  if (showBackend) std::printf(" %-6s", "sdf");
+  std::printf(" %10s %12s\n", "solve", "early stops");
   for (const auto& m : meshes) {
-    const Row* p = find(m, base);
-    if (!p) continue;
-    for (const auto& method : o.methods) {
+    for (const auto& [method, backend] : variants) {
       if (method == base) continue;
-      const Row* r = find(m, method);
-      if (!r) continue;
+      const Row* r = find(m, method, backend);
+      const Row* p =
+          find(m, base, backend == "none" ? backends.empty() ? "" : backends.front() : backend);
+      if (!r || !p) continue;
       const double solve = percentile(r->solveUs, 0.5) / percentile(p->solveUs, 0.5);
       const std::string early = p->earlyStops > 0
                                     ? fmt(double(r->earlyStops) / p->earlyStops, "%.2f")
                                     : std::to_string(r->earlyStops) + " vs 0";
-      std::printf("%-24s %-16s %10s %12s\n", m.c_str(), method.c_str(), fmt(solve, "%.2f").c_str(),
-                  early.c_str());
+      std::printf("%-24s %-16s", m.c_str(), method.c_str());
+      if (showBackend) std::printf(" %-6s", backend.c_str());
+      std::printf(" %10s %12s\n", fmt(solve, "%.2f").c_str(), early.c_str());
     }
   }
 }
@@ -733,12 +787,20 @@ int main(int argc, char** argv) {
   }
   const unsigned threads =
       o.threads ? o.threads : std::max(1u, std::thread::hardware_concurrency());
+  // The sweep compares the backends asked for; by default both (the issue's side-by-side table).
+  const std::vector<std::string> scalingBackends =
+      o.sdfBackendsGiven ? o.sdfBackends
+                         : std::vector<std::string>{tools::kCpuBackend, tools::kVulkanBackend};
+  auto reportExitCode = [](bench::ReportStatus status) {
+    return status == bench::ReportStatus::failed                ? 1
+           : status == bench::ReportStatus::backend_unavailable ? kExitBackendUnavailable
+                                                                : 0;
+  };
   if (!o.reportFrom.empty()) {
     // A long run's results, reported again (new plots, new notes) without solving again.
-    const bool ok = bench::runReport(
-        bench::ReportRequest{o.report, o.reportFrom, bench::shellCommandLine(argc, argv), threads,
-                             o.scalingQuick, o.resolution, sharedMeshesDir()});
-    return ok ? 0 : 1;
+    return reportExitCode(bench::runReport(bench::ReportRequest{
+        o.report, o.reportFrom, bench::shellCommandLine(argc, argv), threads, o.scalingQuick,
+        o.resolution, sharedMeshesDir(), scalingBackends, o.scalingJson, o.scalingFrom}));
   }
 
   std::vector<MeshSource> sources;
@@ -764,7 +826,26 @@ int main(int argc, char** argv) {
   const HandModel hand = HandModel::defaultAdult(Hand::right);
   GridBox box = GridBox::referenceDefault();
   box.resolution = glm::uvec3(uint32_t(o.resolution));
-  CpuSdfBuilder builder(threads);
+  // One builder per backend asked for; one without a device is left out, with its rows.
+  std::vector<std::unique_ptr<tools::TimedSdfBuilder>> builderStore;
+  std::vector<tools::TimedSdfBuilder*> builders;
+  bool backendMissing = false;
+  tools::TimedBuilderOptions builderOptions;
+  builderOptions.cpuThreads = threads;
+  for (const std::string& backend : o.sdfBackends) {
+    auto b = tools::makeTimedBuilder(backend, builderOptions);
+    if (!b) {
+      std::fprintf(stderr,
+                   "autograsp-bench: --sdf-backend %s: %s; its rows are left out (exit code %d)\n",
+                   backend.c_str(), b.error().message.c_str(), kExitBackendUnavailable);
+      backendMissing = true;
+      continue;
+    }
+    std::fprintf(stderr, "autograsp-bench: SDF backend %s on %s\n", backend.c_str(),
+                 (*b)->device().c_str());
+    builders.push_back(b->get());
+    builderStore.push_back(std::move(b.value()));
+  }
   const Progress progress;
 
   bool failed = false;
@@ -791,7 +872,7 @@ int main(int argc, char** argv) {
     }
     const auto t0 = std::chrono::steady_clock::now();
     PhaseSeconds phases;
-    auto meshRows = runMesh(source.name, *mesh, o, hand, box, builder, threads, progress, phases);
+    auto meshRows = runMesh(source.name, *mesh, o, hand, box, builders, threads, progress, phases);
     if (!meshRows) {
       std::fprintf(stderr, "autograsp-bench: skipping %s: %s\n",
                    source.path ? source.path->string().c_str() : source.name.c_str(),
@@ -805,7 +886,7 @@ int main(int argc, char** argv) {
     }
     std::fprintf(stderr,
                  "%s: %zu triangles, done in %.1f s (placements + solves %.1f s, grading %.1f s)\n",
-                 source.name.c_str(), rows.back().triangles,
+                 source.name.c_str(), mesh->triangleCount(),
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
                  phases.solve, phases.grade);
   }
@@ -816,10 +897,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "autograsp-bench: cannot write %s\n", o.json.c_str());
     failed = true;
   }
-  if (o.scaling && !bench::runReport(bench::ReportRequest{
-                       o.report, o.json, bench::shellCommandLine(argc, argv), threads,
-                       o.scalingQuick, o.resolution, sharedMeshesDir()})) {
-    failed = true;
+  if (o.scaling) {
+    const int code = reportExitCode(bench::runReport(bench::ReportRequest{
+        o.report, o.json, bench::shellCommandLine(argc, argv), threads, o.scalingQuick,
+        o.resolution, sharedMeshesDir(), scalingBackends, o.scalingJson, o.scalingFrom}));
+    failed = failed || code == 1;
+    backendMissing = backendMissing || code == kExitBackendUnavailable;
   }
-  return failed ? 1 : 0;
+  return failed ? 1 : backendMissing ? kExitBackendUnavailable : 0;
 }

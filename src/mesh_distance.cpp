@@ -1,6 +1,7 @@
 #include "mesh_distance.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <mutex>
@@ -347,6 +348,32 @@ float MeshDistance::signedDistanceNear(const glm::vec3& p, uint32_t hintTriangle
   const TriangleBvh::Hit hit = m.bvh.closest(p, seed);
   if (closestTriangle != nullptr) *closestTriangle = hit.triangle;
   return m.sign(p, hit) * float(std::sqrt(hit.distanceSquared));
+}
+
+Status MeshDistance::signedDistances(std::span<const glm::vec3> points,
+                                     std::span<uint32_t> triangles,
+                                     std::span<float> distances) const {
+  static_assert(kGroupSize == TriangleBvh::kPacketSize);
+  if (points.size() != triangles.size() || points.size() != distances.size()) {
+    return Status::invalid_argument;
+  }
+  const Impl& m = *impl_;
+  const size_t triangleCount = m.mesh.triangleCount();
+  std::array<TriangleBvh::Hit, kGroupSize> hits;
+  for (size_t first = 0; first < points.size(); first += kGroupSize) {
+    const size_t count = std::min(kGroupSize, points.size() - first);
+    for (size_t l = 0; l < count; ++l) {
+      const uint32_t hint = triangles[first + l];
+      hits[l] = hint < triangleCount ? m.bvh.evaluate(points[first + l], hint) : TriangleBvh::Hit{};
+    }
+    m.bvh.closestPacket(points.subspan(first, count), std::span(hits.data(), count));
+    for (size_t l = 0; l < count; ++l) {
+      triangles[first + l] = hits[l].triangle;
+      distances[first + l] =
+          m.sign(points[first + l], hits[l]) * float(std::sqrt(hits[l].distanceSquared));
+    }
+  }
+  return Status::ok;
 }
 
 float MeshDistance::windingNumber(const glm::vec3& p) const {

@@ -365,6 +365,24 @@ void TriangleBvh::closestPacket(std::span<const glm::vec3> points, std::span<Hit
   if (count == 0 || count != hits.size() || count > kPacketSize || nodes_.empty()) return;
   constexpr float kShrink = 1.0f - 1e-6f;  // as in closest()
 
+  // A point nearer the surface than the group is wide searches a ball that the others' balls
+  // barely overlap, so sharing the walk saves little and the eight-wide filter works for one
+  // lane: such groups take one closest() per point (measured a little faster on the test meshes).
+  {
+    glm::vec3 lo = points[0], hi = points[0];
+    double nearest2 = hits[0].distanceSquared;
+    for (size_t l = 1; l < count; ++l) {
+      lo = glm::min(lo, points[l]);
+      hi = glm::max(hi, points[l]);
+      nearest2 = std::min(nearest2, hits[l].distanceSquared);
+    }
+    const glm::dvec3 extent(hi - lo);
+    if (nearest2 < glm::dot(extent, extent)) {
+      for (size_t l = 0; l < count; ++l) hits[l] = closest(points[l], hits[l]);
+      return;
+    }
+  }
+
   // Lanes past `count` repeat point 0 and are never active.
   alignas(16) float px[kPacketSize], py[kPacketSize], pz[kPacketSize];
   glm::vec3 centre(0.0f);

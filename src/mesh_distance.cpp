@@ -1,6 +1,7 @@
 #include "mesh_distance.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <mutex>
@@ -62,9 +63,23 @@ struct MeshDistance::Impl {
     // spread[j] = sum over triangles of normal_j * integral of (x - center)(x - center)^T dA
     glm::dmat3 spread[3] = {glm::dmat3(0.0), glm::dmat3(0.0), glm::dmat3(0.0)};
   };
+  // What the far-field evaluation reads per node, with the expansion folded into polynomials of
+  // r = center - p (about half the arithmetic of evaluating it from the moments, and a third of
+  // the memory of a Cluster):
+  //   omega += (normalSum . r + trace) / |r|^3 - (3 quadratic(r) + 1.5 linear . r) / |r|^5
+  //            + 7.5 cubic(r) / |r|^7.
+  struct FarField {
+    glm::dvec3 center{0.0};
+    double reach2 = 0.0;  // (kWindingBeta radius)^2: farther than this, the expansion is used
+    glm::dvec3 normalSum{0.0};
+    double trace = 0.0;  // of Cluster::moment
+    glm::dvec3 linear{0.0};
+    double quadratic[6] = {};  // xx yy zz xy xz yz
+    double cubic[10] = {};     // xxx yyy zzz xxy xxz xyy yyz xzz yzz xyz
+  };
   // Built on first need: at creation for meshes signed by winding number, on the first
   // windingNumber() call otherwise (big closed meshes never pay its memory).
-  mutable std::vector<Cluster> clusters;
+  mutable std::vector<FarField> clusters;
   mutable std::atomic<bool> clustersReady{false};
   mutable std::mutex clustersMutex;
 
@@ -142,11 +157,11 @@ void MeshDistance::Impl::computeNormals() {
 void MeshDistance::Impl::computeClusters() const {
   const auto nodes = bvh.nodes();
   const auto corners = bvh.corners();
-  clusters.assign(nodes.size(), Cluster{});
+  std::vector<Cluster> full(nodes.size());
   // Children follow their parents in the node array: a backward pass builds bottom-up.
   for (size_t i = nodes.size(); i-- > 0;) {
     const TriangleBvh::Node& node = nodes[i];
-    Cluster& c = clusters[i];
+    Cluster& c = full[i];
     if (node.count > 0) {
       glm::dvec3 weighted(0.0);
       for (uint32_t s = node.first; s < node.first + node.count; ++s) {
@@ -176,8 +191,8 @@ void MeshDistance::Impl::computeClusters() const {
                              glm::length(cc - c.center)});
       }
     } else {
-      const Cluster& l = clusters[node.first];
-      const Cluster& r = clusters[node.first + 1];
+      const Cluster& l = full[node.first];
+      const Cluster& r = full[node.first + 1];
       c.area = l.area + r.area;
       c.center = (l.area * l.center + r.area * r.center) / c.area;
       c.normalSum = l.normalSum + r.normalSum;
@@ -198,6 +213,59 @@ void MeshDistance::Impl::computeClusters() const {
                           glm::length(r.center - c.center) + r.radius);
     }
   }
+  // Fold the moments into the polynomial coefficients of FarField (see winding()).
+  clusters.assign(nodes.size(), FarField{});
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    const Cluster& c = full[i];
+    FarField& f = clusters[i];
+    f.center = c.center;
+    f.reach2 = kWindingBeta * kWindingBeta * c.radius * c.radius;
+    f.normalSum = c.normalSum;
+    f.trace = c.moment[0][0] + c.moment[1][1] + c.moment[2][2];
+    // r . (moment r) = sum over row, col of moment[col][row] r_row r_col.
+    const glm::dmat3& m = c.moment;
+    f.quadratic[0] = m[0][0];
+    f.quadratic[1] = m[1][1];
+    f.quadratic[2] = m[2][2];
+    f.quadratic[3] = m[1][0] + m[0][1];
+    f.quadratic[4] = m[2][0] + m[0][2];
+    f.quadratic[5] = m[2][1] + m[1][2];
+    // 2 sum_j (spread_j r)_j + sum_j r_j trace(spread_j) = linear . r.
+    for (int k = 0; k < 3; ++k) {
+      for (int j = 0; j < 3; ++j) f.linear[k] += 2.0 * c.spread[j][k][j];
+      f.linear[k] += c.spread[k][0][0] + c.spread[k][1][1] + c.spread[k][2][2];
+    }
+    // sum_j r_j (r . spread_j r) = sum over j, row, col of spread_j[col][row] r_j r_row r_col,
+    // gathered per monomial (index: sorted exponents as in FarField::cubic).
+    for (int j = 0; j < 3; ++j) {
+      for (int row = 0; row < 3; ++row) {
+        for (int col = 0; col < 3; ++col) {
+          const int e[3] = {(j == 0) + (row == 0) + (col == 0), (j == 1) + (row == 1) + (col == 1),
+                            (j == 2) + (row == 2) + (col == 2)};
+          int slot = 9;  // xyz
+          if (e[0] == 3)
+            slot = 0;
+          else if (e[1] == 3)
+            slot = 1;
+          else if (e[2] == 3)
+            slot = 2;
+          else if (e[0] == 2 && e[1] == 1)
+            slot = 3;
+          else if (e[0] == 2 && e[2] == 1)
+            slot = 4;
+          else if (e[1] == 2 && e[0] == 1)
+            slot = 5;
+          else if (e[1] == 2 && e[2] == 1)
+            slot = 6;
+          else if (e[2] == 2 && e[0] == 1)
+            slot = 7;
+          else if (e[2] == 2 && e[1] == 1)
+            slot = 8;
+          f.cubic[slot] += c.spread[j][col][row];
+        }
+      }
+    }
+  }
 }
 
 double MeshDistance::Impl::winding(const glm::vec3& pf) const {
@@ -211,27 +279,27 @@ double MeshDistance::Impl::winding(const glm::vec3& pf) const {
   stack[top++] = 0;
   while (top > 0) {
     const uint32_t i = stack[--top];
-    const Cluster& c = clusters[i];
+    const FarField& c = clusters[i];
     const glm::dvec3 r = c.center - p;
     const double r2 = glm::dot(r, r);
-    if (r2 > kWindingBeta * kWindingBeta * c.radius * c.radius) {
+    if (r2 > c.reach2) {
       // Far field: Taylor expansion about the cluster centre of the solid angle of dA at x,
       // n.(x - p)/|x - p|^3 (Barill et al. 2018, to second order): the dipole normalSum, then
-      // the first- and second-order corrections for the cluster's spread (moment, spread).
+      // the first- and second-order corrections for the cluster's spread, as polynomials in r.
       const double invL2 = 1.0 / r2;
       const double invL3 = invL2 / std::sqrt(r2);
       const double invL5 = invL3 * invL2;
-      const glm::dvec3 mr = c.moment * r;  // sum area n (d . r)
-      const double trace = c.moment[0][0] + c.moment[1][1] + c.moment[2][2];
-      double a1 = 0.0, a2 = 0.0, a3 = 0.0;
-      for (int j = 0; j < 3; ++j) {
-        const glm::dvec3 sr = c.spread[j] * r;
-        a1 += sr[j];
-        a2 += r[j] * (c.spread[j][0][0] + c.spread[j][1][1] + c.spread[j][2][2]);
-        a3 += r[j] * glm::dot(r, sr);
-      }
-      omega += glm::dot(c.normalSum, r) * invL3 + trace * invL3 - 3.0 * glm::dot(r, mr) * invL5 -
-               1.5 * (2.0 * a1 + a2) * invL5 + 7.5 * a3 * invL5 * invL2;
+      const double x = r.x, y = r.y, z = r.z;
+      const double* q = c.quadratic;
+      const double* k = c.cubic;
+      const double quadratic =
+          q[0] * x * x + q[1] * y * y + q[2] * z * z + q[3] * x * y + q[4] * x * z + q[5] * y * z;
+      const double cubic = x * (k[0] * x * x + k[3] * x * y + k[4] * x * z + k[9] * y * z) +
+                           y * (k[1] * y * y + k[5] * x * y + k[6] * y * z) +
+                           z * (k[2] * z * z + k[7] * x * z + k[8] * y * z);
+      omega += (glm::dot(c.normalSum, r) + c.trace) * invL3 -
+               (3.0 * quadratic + 1.5 * glm::dot(c.linear, r)) * invL5 +
+               7.5 * cubic * invL5 * invL2;
       continue;
     }
     const TriangleBvh::Node& node = nodes[i];
@@ -347,6 +415,32 @@ float MeshDistance::signedDistanceNear(const glm::vec3& p, uint32_t hintTriangle
   const TriangleBvh::Hit hit = m.bvh.closest(p, seed);
   if (closestTriangle != nullptr) *closestTriangle = hit.triangle;
   return m.sign(p, hit) * float(std::sqrt(hit.distanceSquared));
+}
+
+Status MeshDistance::signedDistances(std::span<const glm::vec3> points,
+                                     std::span<uint32_t> triangles,
+                                     std::span<float> distances) const {
+  static_assert(kGroupSize == TriangleBvh::kPacketSize);
+  if (points.size() != triangles.size() || points.size() != distances.size()) {
+    return Status::invalid_argument;
+  }
+  const Impl& m = *impl_;
+  const size_t triangleCount = m.mesh.triangleCount();
+  std::array<TriangleBvh::Hit, kGroupSize> hits;
+  for (size_t first = 0; first < points.size(); first += kGroupSize) {
+    const size_t count = std::min(kGroupSize, points.size() - first);
+    for (size_t l = 0; l < count; ++l) {
+      const uint32_t hint = triangles[first + l];
+      hits[l] = hint < triangleCount ? m.bvh.evaluate(points[first + l], hint) : TriangleBvh::Hit{};
+    }
+    m.bvh.closestPacket(points.subspan(first, count), std::span(hits.data(), count));
+    for (size_t l = 0; l < count; ++l) {
+      triangles[first + l] = hits[l].triangle;
+      distances[first + l] =
+          m.sign(points[first + l], hits[l]) * float(std::sqrt(hits[l].distanceSquared));
+    }
+  }
+  return Status::ok;
 }
 
 float MeshDistance::windingNumber(const glm::vec3& p) const {

@@ -52,6 +52,16 @@ class MeshDistance {
   // range is ignored. Writes the closest triangle to *closestTriangle when it is not null.
   float signedDistanceNear(const glm::vec3& p, uint32_t hintTriangle,
                            uint32_t* closestTriangle = nullptr) const;
+  // Points signedDistances() takes in one group.
+  static constexpr size_t kGroupSize = 8;
+
+  // signedDistanceNear() for many points: points[i] gets distances[i], with triangles[i] its hint
+  // on entry and its closest triangle on return. Consecutive groups of kGroupSize points share one
+  // walk of the hierarchy, so each group should lie close together (a 2x2x2 block of grid nodes);
+  // any order gives the same values, only slower. The three spans must have the same size, else
+  // invalid_argument and nothing is written.
+  Status signedDistances(std::span<const glm::vec3> points, std::span<uint32_t> triangles,
+                         std::span<float> distances) const;
   // Generalized winding number: ~1 inside, ~0 outside, fractional near holes.
   float windingNumber(const glm::vec3& p) const;
 

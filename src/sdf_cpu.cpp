@@ -1,6 +1,7 @@
 #include "sdf_cpu.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <condition_variable>
 #include <functional>
@@ -83,24 +84,50 @@ Status CpuSdfBuilder::build(const MeshDistance& target, const Pose& objectFromHa
   SdfGrid grid(box);
   const Pose objectFromBox = objectFromHand * box.handFromBox;
   const glm::uvec3 n = box.resolution;
-  const uint32_t rows = n.y * n.z;
+  // Work is handed out by rows of 2x2x2 blocks of nodes along x. A block's nodes share one walk of
+  // the triangle hierarchy (MeshDistance::signedDistances), and each node is seeded with the
+  // closest triangle of the nearest node of the previous block along x, whose distance bounds the
+  // search. Rows start unseeded and never depend on one another, so
+  // the grid is the same whatever the thread count.
+  const glm::uvec3 blocks = (n + 1u) / 2u;
+  const uint32_t rows = blocks.y * blocks.z;
   std::span<float> values = grid.values();
   std::atomic<uint32_t> nextRow{0};
 
-  // Work is handed out by rows along x. Each row starts unseeded and seeds every later node
-  // with the previous node's closest triangle, whose distance at the new node is within one
-  // spacing of the answer and prunes most of the hierarchy. Rows never depend on one another,
-  // so the grid is the same whatever the thread count.
   const std::function<void()> work = [&] {
+    constexpr size_t kGroup = MeshDistance::kGroupSize;
+    static_assert(kGroup == 8, "a group is one 2x2x2 block");
     for (;;) {
       const uint32_t row = nextRow.fetch_add(1, std::memory_order_relaxed);
       if (row >= rows) return;
-      const uint32_t j = row % n.y, k = row / n.y;
-      uint32_t hint = std::numeric_limits<uint32_t>::max();
-      float* dst = &values[grid.index(0, j, k)];
-      for (uint32_t i = 0; i < n.x; ++i) {
-        const glm::vec3 p = objectFromBox.transformPoint(box.nodeLocal(i, j, k));
-        dst[i] = target.signedDistanceNear(p, hint, &hint);
+      const uint32_t j0 = 2 * (row % blocks.y), k0 = 2 * (row / blocks.y);
+      // hint[c]: closest triangle last found at corner c = dx + 2 dy + 4 dz of a block.
+      std::array<uint32_t, kGroup> hint;
+      hint.fill(std::numeric_limits<uint32_t>::max());
+      std::array<glm::vec3, kGroup> points;
+      std::array<uint32_t, kGroup> triangles, corner;
+      std::array<float, kGroup> distances;
+      std::array<size_t, kGroup> slot;
+      for (uint32_t i0 = 0; i0 < n.x; i0 += 2) {
+        size_t count = 0;
+        for (uint32_t c = 0; c < kGroup; ++c) {
+          const uint32_t i = i0 + (c & 1), j = j0 + ((c >> 1) & 1), k = k0 + (c >> 2);
+          if (i >= n.x || j >= n.y || k >= n.z) continue;  // odd resolution: a partial block
+          points[count] = objectFromBox.transformPoint(box.nodeLocal(i, j, k));
+          triangles[count] = hint[c];
+          corner[count] = c;
+          slot[count] = grid.index(i, j, k);
+          ++count;
+        }
+        target.signedDistances(std::span(points.data(), count), std::span(triangles.data(), count),
+                               std::span(distances.data(), count));
+        // The next block's near face (dx = 0) is one step from this block's far face (dx = 1),
+        // its far face two steps: both start from the far face's triangles (corners ascend, so
+        // the far face's write comes last).
+        for (size_t l = 0; l < count; ++l) {
+          values[slot[l]] = distances[l];
+          hint[corner[l] & ~1u] = hint[corner[l] | 1u] = triangles[l];
+        }
       }
     }
   };

@@ -72,6 +72,19 @@ class TriangleBvh {
   // carry that triangle's exact distance (see evaluate()); ties keep the seed.
   Hit closest(const glm::vec3& p, Hit seed = Hit{}) const;
 
+  // Most points closestPacket() takes at once.
+  static constexpr size_t kPacketSize = 8;
+
+  // closest() for up to kPacketSize points at once: hits[i] is point i's seed on entry (same
+  // contract as closest()'s seed) and its result on return; points.size() must equal
+  // hits.size() and be at most kPacketSize (otherwise nothing is done). Meant for points close
+  // together (a 2x2x2 block of grid nodes): one walk of the hierarchy serves them all, and each
+  // triangle is first measured for all of them at once in single precision with a bound on its
+  // rounding error, so the exact double-precision distance is computed only where the triangle
+  // may be the closest. Every result is the same as closest() would give: the exact distance of
+  // the closest triangle (which triangle may differ only between exactly equal distances).
+  void closestPacket(std::span<const glm::vec3> points, std::span<Hit> hits) const;
+
   // The exact hit record of `p` against one triangle (original index).
   Hit evaluate(const glm::vec3& p, uint32_t triangle) const;
 
@@ -92,6 +105,20 @@ class TriangleBvh {
   std::vector<uint32_t> order_;   // leaf slot -> original triangle
   std::vector<uint32_t> slotOf_;  // original triangle -> leaf slot
   std::vector<Corners> corners_;  // per leaf slot, so a leaf reads one contiguous run
+  // Per leaf slot, what closestPacket()'s single-precision filter needs, rounded from double
+  // precision: unit normal, longest edge, and per edge i (from corner i to corner i + 1) the
+  // in-plane normal pointing into the triangle (length |edge|) and 1 / |edge|^2.
+  struct FilterFrame {
+    glm::vec3 normal;
+    float longest;
+    glm::vec3 inward0;
+    float inverse0;
+    glm::vec3 inward1;
+    float inverse1;
+    glm::vec3 inward2;
+    float inverse2;
+  };
+  std::vector<FilterFrame> frames_;
 };
 
 }  // namespace sdfg

@@ -321,3 +321,60 @@ TEST_CASE("closestWithin honours its radius and hints never change the answer", 
     CHECK(closest < triangles);
   }
 }
+
+TEST_CASE("signedDistances over 2x2x2 blocks equals brute force and signedDistance",
+          "[mesh_distance][packet]") {
+  const auto check = [](const TriangleMesh& m, int blocks, uint32_t seed) {
+    const auto d = makeDistance(m);
+    std::mt19937 rng(seed);
+    const float diag = glm::length(computeBounds(m.positions).extent());
+    // Block centres near the surface and far from it; spacings from a hundredth of the
+    // diagonal (nodes close together, the shared walk pays) to a tenth (each point alone).
+    const std::vector<glm::vec3> centres =
+        samplePoints(m, size_t(blocks) / 2, size_t(blocks) / 2, 0.05f * diag, rng);
+    std::uniform_real_distribution<float> spacing(0.01f * diag, 0.1f * diag);
+    std::uniform_int_distribution<uint32_t> anyHint(0, uint32_t(m.triangleCount()) + 10);
+    int bruteChecked = 0;
+    for (const glm::vec3& c : centres) {
+      const float h = spacing(rng);
+      std::vector<glm::vec3> points;
+      std::vector<uint32_t> triangles;
+      for (uint32_t corner = 0; corner < 8; ++corner) {
+        points.push_back(c + h * glm::vec3(corner & 1, (corner >> 1) & 1, corner >> 2));
+        triangles.push_back(anyHint(rng));  // some out of range: ignored
+      }
+      std::vector<float> values(points.size());
+      REQUIRE(d->signedDistances(points, triangles, values) == Status::ok);
+      for (size_t i = 0; i < points.size(); ++i) {
+        CAPTURE(points[i].x, points[i].y, points[i].z, h);
+        CHECK(values[i] == Approx(d->signedDistance(points[i])).margin(1e-7 * diag));
+        CHECK(triangles[i] < m.triangleCount());
+        if (i % 4 == 0) {  // brute force on a subsample: it is O(triangles) per point
+          CHECK(std::abs(values[i]) ==
+                Approx(bruteForceDistance(m, points[i])).margin(1e-7 * diag));
+          ++bruteChecked;
+        }
+      }
+    }
+    CHECK(bruteChecked == 2 * int(centres.size()));
+  };
+  SECTION("closed analytic mesh") {
+    check(icosphereMesh(0.05f, 3), 40, 11);
+  }
+  SECTION("shared meshes, open and closed") {
+    for (const char* name : {"stanford-bunny.obj", "stanford-armadillo-100k.obj"}) {
+      const TriangleMesh* m = normalizedSharedMesh(name);
+      if (m == nullptr) SDFG_SKIP("shared meshes missing");
+      CAPTURE(name);
+      check(*m, 16, 12);
+    }
+  }
+  SECTION("mismatched spans are rejected, nothing written") {
+    const auto d = makeDistance(cubeMesh(0.05f));
+    std::vector<glm::vec3> points(3, glm::vec3(0.2f));
+    std::vector<uint32_t> triangles(3, 0);
+    std::vector<float> values(2, 7.0f);
+    CHECK(d->signedDistances(points, triangles, values) == Status::invalid_argument);
+    CHECK(values == std::vector<float>(2, 7.0f));
+  }
+}

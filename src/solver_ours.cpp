@@ -111,14 +111,6 @@ struct FastSampler {
     return c0 + (c1 - c0) * tz;
   }
 
-  // Second difference of the node values along `axis` at node p (0 at the grid's faces).
-  float secondDifference(const glm::ivec3& p, int axis) const {
-    if (p[axis] <= 0 || p[axis] >= n[axis] - 1) return 0.0f;
-    const size_t stride = axis == 0 ? 1 : (axis == 1 ? sy : sz);
-    const float* c = v + size_t(p.x) + sy * size_t(p.y) + sz * size_t(p.z);
-    return c[stride] - 2.0f * c[0] + c[-std::ptrdiff_t(stride)];
-  }
-
   // Trilinear value minus its leading error term. Linear interpolation of f between nodes h
   // apart misses t(1-t)/2 h^2 f'' at fraction t; f'' comes from the nodes' second differences,
   // blended trilinearly, so the result stays continuous. On smooth parts of a distance field
@@ -129,16 +121,26 @@ struct FastSampler {
     locate(uvw.x, scale.x, n.x, idx[0], t[0]);
     locate(uvw.y, scale.y, n.y, idx[1], t[1]);
     locate(uvw.z, scale.z, n.z, idx[2], t[2]);
+    const std::ptrdiff_t stride[3] = {1, std::ptrdiff_t(sy), std::ptrdiff_t(sz)};
+    const float* base = v + size_t(idx[0]) + sy * size_t(idx[1]) + sz * size_t(idx[2]);
     float correction = 0.0f;
     for (int axis = 0; axis < 3; ++axis) {
       const float bend = t[axis] * (1.0f - t[axis]) * 0.5f;
       if (bend <= 0.0f) continue;
+      // Along `axis`, the cell's two node layers: second differences at idx and idx + 1 (0 on
+      // the grid's faces) from four values per line, blended over the other two axes.
+      const int b = (axis + 1) % 3, c = (axis + 2) % 3;
+      const std::ptrdiff_t sa = stride[axis];
+      const bool haveLow = idx[axis] > 0, haveHigh = idx[axis] + 1 < n[axis] - 1;
       float d = 0.0f;
-      for (int c = 0; c < 8; ++c) {
-        const glm::ivec3 o(c & 1, (c >> 1) & 1, (c >> 2) & 1);
-        const float w =
-            (o.x ? t[0] : 1.0f - t[0]) * (o.y ? t[1] : 1.0f - t[1]) * (o.z ? t[2] : 1.0f - t[2]);
-        d += w * secondDifference(glm::ivec3(idx[0], idx[1], idx[2]) + o, axis);
+      for (int oc = 0; oc < 2; ++oc) {
+        for (int ob = 0; ob < 2; ++ob) {
+          const float* p = base + ob * stride[b] + oc * stride[c];
+          const float d0 = haveLow ? p[-sa] - 2.0f * p[0] + p[sa] : 0.0f;
+          const float d1 = haveHigh ? p[0] - 2.0f * p[sa] + p[2 * sa] : 0.0f;
+          const float w = (ob ? t[b] : 1.0f - t[b]) * (oc ? t[c] : 1.0f - t[c]);
+          d += w * (d0 + (d1 - d0) * t[axis]);
+        }
       }
       correction += bend * d;
     }
@@ -669,7 +671,11 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
       if (s.bone < firstFree || isCand[i]) continue;
       const glm::vec3 uvw = *cx.toBox * centreOf(s) + cx.toBoxOffset;
       const float value = (*cx.sample)(uvw);
-      const float g = std::min(value, cx.sample->corrected(uvw, value)) - s.testRadius;
+      float g = value - s.testRadius;
+      // As in evaluate(): the corrected reading only matters where it can be lower.
+      if (g < kExactBand + kCorrectBand) {
+        g = std::min(value, cx.sample->corrected(uvw, value)) - s.testRadius;
+      }
       if (s.bone <= lastBone && (g < kExactBand || i == touching)) {
         isCand[i] = true;
         fresh[count] = true;

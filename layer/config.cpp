@@ -29,8 +29,9 @@ bool parseBool(const std::string& text, bool& out) {
   return false;
 }
 
-const char* const kKeys[] = {"log_level",  "solver",    "grab_threshold", "release_ratio",
-                             "resolution", "curl_step", "synthesis",      "gpu"};
+const char* const kKeys[] = {"log_level",   "solver",        "grab_threshold", "release_ratio",
+                             "resolution",  "curl_step",     "synthesis",      "gpu",
+                             "extra_queue", "test_gpu_fault"};
 
 }  // namespace
 
@@ -57,6 +58,11 @@ bool applyConfigValue(Config& config, const std::string& key, const std::string&
     ok = parseBool(value, c.synthesis);
   } else if (key == "gpu") {
     ok = parseBool(value, c.gpu);
+  } else if (key == "extra_queue") {
+    ok = parseBool(value, c.extraQueue);
+  } else if (key == "test_gpu_fault") {
+    ok = value == "none" || value == "lost_at_submit" || value == "lost_at_poll";
+    c.testGpuFault = value;
   } else {
     ok = false;
   }

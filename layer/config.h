@@ -19,7 +19,10 @@ struct Config {
   float curlStep = 0.02f;              // curl_step: solver step along each finger curve
   bool synthesis = true;               // synthesis: offer XR_EXT_hand_tracking from controllers
   bool gpu = true;                     // gpu: build SDFs on the app's Vulkan device when possible
-  std::string configPath;              // the file that was read, empty when none
+  bool extraQueue = true;  // extra_queue: add a queue to Vulkan2 apps' devices when one is spare
+  // test_gpu_fault: none, lost_at_submit, lost_at_poll (tests only: a simulated device loss)
+  std::string testGpuFault = "none";
+  std::string configPath;  // the file that was read, empty when none
 };
 
 Config loadConfig();

@@ -13,7 +13,10 @@ namespace sdfg::layer {
   X(xrCreateSession)                     \
   X(xrDestroySession)                    \
   X(xrWaitFrame)                         \
+  X(xrBeginFrame)                        \
   X(xrEndFrame)                          \
+  X(xrCreateVulkanInstanceKHR)           \
+  X(xrCreateVulkanDeviceKHR)             \
   X(xrCreateReferenceSpace)              \
   X(xrCreateActionSpace)                 \
   X(xrLocateSpace)                       \

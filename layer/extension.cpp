@@ -8,6 +8,10 @@
 #include "log.h"
 #include "state.h"
 
+#if SDFG_LAYER_VULKAN
+#include "vk_grasp_backend.h"
+#endif
+
 namespace sdfg::layer {
 namespace {
 
@@ -83,6 +87,99 @@ std::vector<glm::vec3> toPositions(const XrGraspTargetVerticesSDFG& v) {
   return out;
 }
 
+// Checks a Vulkan-buffer description; `target` (update) fixes the counts.
+XrResult verifyBuffers(const char* cmd, const XrGraspTargetVulkanBuffersSDFG* b,
+                       const TargetState* target) {
+  SDFG_VERIFY(cmd, b->vertexBuffer != VK_NULL_HANDLE, XR_ERROR_VALIDATION_FAILURE,
+              "(vertexBuffer) is VK_NULL_HANDLE");
+  SDFG_VERIFY(cmd, b->indexBuffer != VK_NULL_HANDLE, XR_ERROR_VALIDATION_FAILURE,
+              "(indexBuffer) is VK_NULL_HANDLE");
+  SDFG_VERIFY(cmd, b->vertexCount >= 3 && b->vertexCount <= XR_MAX_GRASP_TARGET_VERTICES_SDFG,
+              XR_ERROR_VALIDATION_FAILURE, "(vertexCount) is %u, must be in 3..%u", b->vertexCount,
+              XR_MAX_GRASP_TARGET_VERTICES_SDFG);
+  SDFG_VERIFY(cmd,
+              b->indexCount >= 3 && b->indexCount % 3 == 0 &&
+                  b->indexCount <= XR_MAX_GRASP_TARGET_INDICES_SDFG,
+              XR_ERROR_VALIDATION_FAILURE, "(indexCount) is %u, must be a multiple of 3 in 3..%u",
+              b->indexCount, XR_MAX_GRASP_TARGET_INDICES_SDFG);
+  SDFG_VERIFY(cmd, b->vertexStride >= 12 && b->vertexStride % 4 == 0, XR_ERROR_VALIDATION_FAILURE,
+              "(vertexStride) is %u, must be >= 12 and a multiple of 4", b->vertexStride);
+  SDFG_VERIFY(cmd, b->vertexOffset % 4 == 0, XR_ERROR_VALIDATION_FAILURE,
+              "(vertexOffset) is %llu, must be a multiple of 4",
+              (unsigned long long)b->vertexOffset);
+  SDFG_VERIFY(cmd, b->indexType == VK_INDEX_TYPE_UINT16 || b->indexType == VK_INDEX_TYPE_UINT32,
+              XR_ERROR_VALIDATION_FAILURE, "(indexType) is %d, must be UINT16 or UINT32",
+              int(b->indexType));
+  const VkDeviceSize indexSize = b->indexType == VK_INDEX_TYPE_UINT16 ? 2 : 4;
+  SDFG_VERIFY(cmd, b->indexOffset % indexSize == 0, XR_ERROR_VALIDATION_FAILURE,
+              "(indexOffset) is %llu, must be a multiple of the index size",
+              (unsigned long long)b->indexOffset);
+  const float lo[3] = {b->boundsMin.x, b->boundsMin.y, b->boundsMin.z};
+  const float hi[3] = {b->boundsMax.x, b->boundsMax.y, b->boundsMax.z};
+  for (int a = 0; a < 3; ++a) {
+    SDFG_VERIFY(cmd, std::isfinite(lo[a]) && std::isfinite(hi[a]) && lo[a] <= hi[a],
+                XR_ERROR_VALIDATION_FAILURE,
+                "(boundsMin) and (boundsMax) must be finite with boundsMin <= boundsMax");
+  }
+  if (target != nullptr) {
+    SDFG_VERIFY(cmd, b->vertexCount == target->vertexCount && b->indexCount == target->indexCount,
+                XR_ERROR_VALIDATION_FAILURE,
+                "(vertexCount, indexCount) are %u, %u; the target has %u, %u", b->vertexCount,
+                b->indexCount, target->vertexCount, target->indexCount);
+  }
+  return XR_SUCCESS;
+}
+
+#if SDFG_LAYER_VULKAN
+VkMeshBuffers toMeshBuffers(const XrGraspTargetVulkanBuffersSDFG& b) {
+  VkMeshBuffers m;
+  m.positions = b.vertexBuffer;
+  m.positionOffset = b.vertexOffset;
+  m.positionStride = b.vertexStride;
+  m.vertexCount = b.vertexCount;
+  m.indices = b.indexBuffer;
+  m.indexOffset = b.indexOffset;
+  m.indexType = b.indexType;
+  m.indexCount = b.indexCount;
+  return m;
+}
+#endif
+
+Aabb toBounds(const XrGraspTargetVulkanBuffersSDFG& b) {
+  Aabb a;
+  a.min = glm::vec3(b.boundsMin.x, b.boundsMin.y, b.boundsMin.z);
+  a.max = glm::vec3(b.boundsMax.x, b.boundsMax.y, b.boundsMax.z);
+  return a;
+}
+
+// Creates a buffer target on a Vulkan session (the caller holds the session lock).
+XrResult createBufferTarget(const char* cmd, SessionState& s,
+                            const XrGraspTargetVulkanBuffersSDFG* buffers, TargetState& t) {
+  SDFG_VERIFY(cmd, s.vulkan, XR_ERROR_GRAPHICS_DEVICE_INVALID,
+              "Vulkan buffers need a session with a Vulkan graphics binding");
+  if (XrResult r = verifyBuffers(cmd, buffers, nullptr); r != XR_SUCCESS) return r;
+#if SDFG_LAYER_VULKAN
+  SDFG_VERIFY(cmd, s.vulkanBackend != nullptr && s.grasp->deferredUsable(),
+              XR_ERROR_FEATURE_UNSUPPORTED,
+              "this session builds its SDFs on the CPU (gpu = false, no usable Vulkan device, or "
+              "a GPU failure): Vulkan buffer targets need the GPU path; pass arrays");
+  if (Status st = s.vulkanBackend->setDeviceMesh(t.handle, toMeshBuffers(*buffers));
+      st != Status::ok)
+    return logError(toXrResult(st), cmd, "the buffers were refused (%s)", toString(st));
+  if (Status st = s.grasp->addDeviceTarget(t.handle, toBounds(*buffers)); st != Status::ok) {
+    s.vulkanBackend->removeDeviceMesh(t.handle);
+    return logError(toXrResult(st), cmd, "the target could not be added (%s)", toString(st));
+  }
+  t.vertexCount = buffers->vertexCount;
+  t.indexCount = buffers->indexCount;
+  t.deviceBuffers = true;
+  return XR_SUCCESS;
+#else
+  return logError(XR_ERROR_FEATURE_UNSUPPORTED, cmd,
+                  "this build of the layer has no Vulkan backend; pass arrays");
+#endif
+}
+
 }  // namespace
 
 XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
@@ -105,10 +202,17 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
   SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
   if (XrResult r = verifyPlacement(cmd, *s, &createInfo->placement); r != XR_SUCCESS) return r;
   if (buffers != nullptr) {
-    SDFG_VERIFY(cmd, s->vulkan, XR_ERROR_GRAPHICS_DEVICE_INVALID,
-                "Vulkan buffers need a session with a Vulkan graphics binding");
-    return logError(XR_ERROR_FEATURE_UNSUPPORTED, cmd,
-                    "Vulkan buffer targets are not supported by this build yet; pass arrays");
+    auto t = std::make_shared<TargetState>();
+    t->handle = newLayerHandle();
+    t->session = s;
+    t->space = createInfo->placement.space;
+    t->pose = createInfo->placement.pose;
+    if (XrResult r = createBufferTarget(cmd, *s, buffers, *t); r != XR_SUCCESS) return r;
+    s->targets[t->handle] = t;
+    *target = fromKey<XrGraspTargetSDFG>(t->handle);
+    const uint64_t handle = t->handle;
+    targets().insert(handle, std::move(t));
+    return XR_SUCCESS;
   }
   if (XrResult r = verifyVertices(cmd, arrays, false, 0); r != XR_SUCCESS) return r;
   auto mesh = makeMesh(toPositions(*arrays),
@@ -121,6 +225,7 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
   t->space = createInfo->placement.space;
   t->pose = createInfo->placement.pose;
   t->vertexCount = arrays->vertexCount;
+  t->indexCount = arrays->indexCount;
   if (Status st = s->grasp->addTarget(t->handle, *mesh); st != Status::ok)
     return logError(toXrResult(st), cmd, "the target could not be built (%s)", toString(st));
   s->targets[t->handle] = t;
@@ -139,6 +244,11 @@ XrResult XRAPI_CALL SdfgXrDestroyGraspTargetSDFG(XrGraspTargetSDFG target) {
   std::lock_guard lock(s->mutex);
   // A hand holding it lets go; its fingers return to the user's pose at the next locate.
   if (s->grasp != nullptr) s->grasp->removeTarget(t->handle);
+#if SDFG_LAYER_VULKAN
+  // Waits for the layer's reads of the app's buffers in flight: the app may free them next.
+  if (t->deviceBuffers && s->vulkanBackend != nullptr)
+    s->vulkanBackend->removeDeviceMesh(t->handle);
+#endif
   s->targets.erase(t->handle);
   targets().erase(t->handle);
   return XR_SUCCESS;
@@ -153,12 +263,31 @@ XrResult XRAPI_CALL SdfgXrUpdateGraspTargetVerticesSDFG(XrGraspTargetSDFG target
   SDFG_VERIFY(cmd, t != nullptr, XR_ERROR_HANDLE_INVALID, "(target) is not valid");
   SDFG_VERIFY_NOT_NULL(cmd, vertices);
   const auto* base = static_cast<const XrBaseInStructure*>(vertices);
-  if (base->type == XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG)
-    return logError(XR_ERROR_FEATURE_UNSUPPORTED, cmd,
-                    "Vulkan buffer targets are not supported yet");
+  if (base->type == XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG) {
+    const auto* b = static_cast<const XrGraspTargetVulkanBuffersSDFG*>(vertices);
+    SDFG_VERIFY(cmd, t->deviceBuffers, XR_ERROR_VALIDATION_FAILURE,
+                "(vertices) are Vulkan buffers; the target was created from arrays");
+    if (XrResult r = verifyBuffers(cmd, b, t.get()); r != XR_SUCCESS) return r;
+    std::lock_guard lock(s->mutex);
+    SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
+#if SDFG_LAYER_VULKAN
+    SDFG_VERIFY(cmd, s->vulkanBackend != nullptr && s->grasp->deferredUsable(),
+                XR_ERROR_FEATURE_UNSUPPORTED,
+                "the session's GPU path failed: buffer targets can no longer be grasped");
+    if (Status st = s->vulkanBackend->setDeviceMesh(t->handle, toMeshBuffers(*b)); st != Status::ok)
+      return logError(toXrResult(st), cmd, "the buffers were refused (%s)", toString(st));
+    (void)s->grasp->touchTarget(t->handle);
+    (void)s->grasp->updateTargetBounds(t->handle, toBounds(*b));
+    return XR_SUCCESS;
+#else
+    return logError(XR_ERROR_FEATURE_UNSUPPORTED, cmd, "no Vulkan backend in this build");
+#endif
+  }
   SDFG_VERIFY(cmd, base->type == XR_TYPE_GRASP_TARGET_VERTICES_SDFG, XR_ERROR_VALIDATION_FAILURE,
               "(vertices->type) is %d, expected XR_TYPE_GRASP_TARGET_VERTICES_SDFG",
               int(base->type));
+  SDFG_VERIFY(cmd, !t->deviceBuffers, XR_ERROR_VALIDATION_FAILURE,
+              "(vertices) are arrays; the target was created from Vulkan buffers");
   const auto* v = static_cast<const XrGraspTargetVerticesSDFG*>(vertices);
   if (XrResult r = verifyVertices(cmd, v, true, t->vertexCount); r != XR_SUCCESS) return r;
   const std::vector<glm::vec3> positions = toPositions(*v);
@@ -211,6 +340,18 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
     const glm::vec3 p = held ? g.objectFromHand.transformPoint(fs.contactPoint) : glm::vec3(0.0f);
     out.contactPoint = {p.x, p.y, p.z};
     out.distance = held ? fs.distance : 0.0f;
+  }
+  if (auto* info = findInChain<XrGraspBuildInfoSDFG>(state->next, XR_TYPE_GRASP_BUILD_INFO_SDFG)) {
+    const SdfBuildStats& st = s->grasp->buildStats();
+    info->graspBackend = !held          ? XR_GRASP_SDF_BACKEND_NONE_SDFG
+                         : g.builtOnGpu ? XR_GRASP_SDF_BACKEND_VULKAN_SDFG
+                                        : XR_GRASP_SDF_BACKEND_CPU_SDFG;
+    info->sessionBackend = s->grasp->deferredUsable() ? XR_GRASP_SDF_BACKEND_VULKAN_SDFG
+                                                      : XR_GRASP_SDF_BACKEND_CPU_SDFG;
+    info->gpuBuildCount = st.gpuBuilds;
+    info->cpuBuildCount = st.cpuBuilds;
+    info->gpuFailed = st.gpuFailed ? XR_TRUE : XR_FALSE;
+    info->pendingGpuBuilds = uint32_t(s->grasp->pendingBuilds());
   }
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)

@@ -231,6 +231,8 @@ XrResult XRAPI_CALL SdfgXrSyncActions(XrSession session, const XrActionsSyncInfo
     try {
       std::lock_guard lock(s->mutex);
       updateGrasps(*s);
+      // A queue of the layer's own takes the new builds at once; the app's waits for the frame.
+      if (s->ownQueue) submitGpuWork(*s, false, cmd);
     } catch (...) {
       SDFG_LOG_WARN(cmd, "grab update failed; hands pass through this frame");
     }

@@ -17,6 +17,14 @@ XrResult XRAPI_CALL SdfgXrCreateReferenceSpace(XrSession, const XrReferenceSpace
 XrResult XRAPI_CALL SdfgXrCreateActionSpace(XrSession, const XrActionSpaceCreateInfo*, XrSpace*);
 XrResult XRAPI_CALL SdfgXrDestroySpace(XrSpace);
 
+// vulkan.cpp
+XrResult XRAPI_CALL SdfgXrBeginFrame(XrSession, const XrFrameBeginInfo*);
+XrResult XRAPI_CALL SdfgXrEndFrame(XrSession, const XrFrameEndInfo*);
+XrResult XRAPI_CALL SdfgXrCreateVulkanInstanceKHR(XrInstance, const XrVulkanInstanceCreateInfoKHR*,
+                                                  VkInstance*, VkResult*);
+XrResult XRAPI_CALL SdfgXrCreateVulkanDeviceKHR(XrInstance, const XrVulkanDeviceCreateInfoKHR*,
+                                                VkDevice*, VkResult*);
+
 // input.cpp
 XrResult XRAPI_CALL
 SdfgXrSuggestInteractionProfileBindings(XrInstance, const XrInteractionProfileSuggestedBinding*);

@@ -1,6 +1,7 @@
 // Loader entry: negotiation, xrCreateApiLayerInstance, xrGetInstanceProcAddr routing,
 // xrDestroyInstance and the layer's xrEnumerateInstanceExtensionProperties.
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,54 @@ bool contains(const std::vector<std::string>& list, const char* name) {
     if (s == name) return true;
   }
   return false;
+}
+
+// Layers that add no instance extension and mishandle xrGetInstanceProcAddr(XR_NULL_HANDLE):
+// core validation 1.0.20 answers it but prints "INTERNAL VALIDATION LAYER ERROR: Null handle
+// passed to HandleInfoBase::get()" on stderr. Asking past them loses nothing.
+constexpr const char* kSkipForQuery[] = {"XR_APILAYER_LUNARG_core_validation",
+                                         "XR_APILAYER_LUNARG_api_dump"};
+
+// The instance extensions the chain below offers, asked before creating the instance so that a
+// runtime without hand tracking is never sent a list it refuses (a failed create makes core
+// validation 1.0.20 print "INTERNAL VALIDATION LAYER ERROR: Null handle passed to
+// HandleInfoBase::insert()", and some runtimes log it). Entries are asked nearest first; one in
+// kSkipForQuery, or one that refuses the query, is stepped over, which loses only extensions
+// that layer itself would add. The last entry is the loader's terminator, which asks the
+// runtime. Nothing when no entry answers.
+std::optional<std::vector<std::string>> chainExtensions(const XrApiLayerNextInfo* nextInfo) {
+  constexpr const char* cmd = "xrCreateApiLayerInstance";
+  for (const XrApiLayerNextInfo* info = nextInfo; info != nullptr; info = info->next) {
+    // An entry's gipa is that of the layer named in the entry after it (the last entry's: the
+    // loader's terminator).
+    bool skip = false;
+    for (const char* name : kSkipForQuery)
+      skip |= info->next != nullptr &&
+              std::strncmp(info->next->layerName, name, kMaxApiLayerNameSize) == 0;
+    if (skip) continue;
+    PFN_xrVoidFunction f = nullptr;
+    if (info->nextGetInstanceProcAddr == nullptr ||
+        info->nextGetInstanceProcAddr(XR_NULL_HANDLE, "xrEnumerateInstanceExtensionProperties",
+                                      &f) != XR_SUCCESS ||
+        f == nullptr)
+      continue;
+    auto enumerate = reinterpret_cast<PFN_xrEnumerateInstanceExtensionProperties>(f);
+    uint32_t count = 0;
+    XrResult r = enumerate(nullptr, 0, &count, nullptr);
+    std::vector<XrExtensionProperties> props;
+    if (XR_SUCCEEDED(r)) {
+      props.assign(count, XrExtensionProperties{XR_TYPE_EXTENSION_PROPERTIES});
+      r = enumerate(nullptr, count, &count, props.data());
+    }
+    SDFG_LOG_INFO(cmd, "extensions below '%.256s': %d (%u)",
+                  info->next != nullptr ? info->next->layerName : "(runtime)", int(r), count);
+    if (XR_FAILED(r)) continue;
+    std::vector<std::string> names;
+    for (uint32_t i = 0; i < count && i < props.size(); ++i)
+      names.emplace_back(props[i].extensionName);
+    return names;
+  }
+  return std::nullopt;
 }
 
 XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* info,
@@ -76,12 +125,17 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
   state->appHandTracking = contains(appExtensions, XR_EXT_HAND_TRACKING_EXTENSION_NAME);
   state->appMotionRange = contains(appExtensions, XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME);
   state->appDebugUtils = contains(appExtensions, XR_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  state->appVulkan2 = contains(appExtensions, XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME);
 
-  // The runtime's extensions cannot be listed from here: layers below (core validation 1.0.20)
-  // refuse xrEnumerateInstanceExtensionProperties without an instance. So ask by trying, as
-  // HTCC does: the full list first, then without motion range, then without hand tracking, each
-  // retried only when the chain refuses the list.
+  // What the chain offers decides the list sent down. Only when nobody below answers the query
+  // does the layer find out by trying, as HTCC does: the full list first, then without motion
+  // range, then without hand tracking, each tried only when the chain refuses the previous one.
   const bool wantHandTracking = state->appHandTracking || state->appAutoGrasp;
+  const std::optional<std::vector<std::string>> offered = chainExtensions(nextInfo);
+  const bool offersHandTracking =
+      !offered || contains(*offered, XR_EXT_HAND_TRACKING_EXTENSION_NAME);
+  const bool offersMotionRange =
+      !offered || contains(*offered, XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME);
   XrApiLayerCreateInfo downLayerInfo = *layerInfo;
   downLayerInfo.nextInfo = nextInfo->next;
   // Core validation 1.0.20 reports the runtime's refusal as XR_ERROR_INITIALIZATION_FAILED.
@@ -94,6 +148,9 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
     const bool withHandTracking = attempt < 2;
     if (attempt == 1 && !state->appMotionRange) continue;
     if (attempt == 2 && !wantHandTracking) break;
+    // Lists the chain said it lacks are not tried at all.
+    if (withMotionRange && state->appMotionRange && !offersMotionRange) continue;
+    if (withHandTracking && wantHandTracking && !offersHandTracking) continue;
     state->runtimeHandTracking = withHandTracking;
     state->runtimeMotionRange = withMotionRange;
     state->provideHandTracking = state->appHandTracking && !withHandTracking;
@@ -141,6 +198,16 @@ XrResult XRAPI_CALL SdfgXrDestroyInstance(XrInstance instance) {
   auto state = instances().find(key(instance));
   if (state == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(instance) is not valid");
   clearDebugUtilsSink(instance);
+  // Sessions the app did not destroy go with the instance: their GPU work first (waits for
+  // builds in flight), while the app's Vulkan device surely exists.
+  std::vector<std::shared_ptr<SessionState>> own;
+  sessions().forEach([&](const std::shared_ptr<SessionState>& s) {
+    if (s->instance == state) own.push_back(s);
+  });
+  for (const auto& s : own) {
+    std::lock_guard lock(s->mutex);  // not under the map's lock: sessions lock it the other way
+    dropGpuWork(*s);
+  }
   const XrResult r = state->next.xrDestroyInstance(instance);
   if (XR_SUCCEEDED(r)) {
     // The instance took its sessions and their children with it.
@@ -195,6 +262,7 @@ enum class Gate {
   active,        // only when the layer is active on the instance, else the next layer's function
   autoGrasp,     // XR_SDFG_auto_grasp commands: only when the app enabled it
   handTracking,  // XR_EXT_hand_tracking commands: enabled by the app; ours when active
+  vulkan2,       // XR_KHR_vulkan_enable2 commands: ours when active and the app enabled it
 };
 
 struct Route {
@@ -215,6 +283,10 @@ const Route kRoutes[] = {
     SDFG_ROUTE(XrCreateSession, Gate::active),
     SDFG_ROUTE(XrDestroySession, Gate::active),
     SDFG_ROUTE(XrWaitFrame, Gate::active),
+    SDFG_ROUTE(XrBeginFrame, Gate::active),
+    SDFG_ROUTE(XrEndFrame, Gate::active),
+    SDFG_ROUTE(XrCreateVulkanInstanceKHR, Gate::vulkan2),
+    SDFG_ROUTE(XrCreateVulkanDeviceKHR, Gate::vulkan2),
     SDFG_ROUTE(XrCreateReferenceSpace, Gate::active),
     SDFG_ROUTE(XrCreateActionSpace, Gate::active),
     SDFG_ROUTE(XrDestroySpace, Gate::active),
@@ -270,6 +342,12 @@ XrResult XRAPI_CALL SdfgXrGetInstanceProcAddr(XrInstance instance, const char* n
         if (!state->appAutoGrasp) return XR_ERROR_FUNCTION_UNSUPPORTED;
         *function = route.function;
         return XR_SUCCESS;
+      case Gate::vulkan2:
+        if (state->active && state->appVulkan2 && state->appAutoGrasp) {
+          *function = route.function;
+          return XR_SUCCESS;
+        }
+        break;
       case Gate::handTracking:
         if (!state->appHandTracking) return XR_ERROR_FUNCTION_UNSUPPORTED;
         if (state->active) {

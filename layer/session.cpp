@@ -71,8 +71,11 @@ XrResult XRAPI_CALL SdfgXrCreateSession(XrInstance instance, const XrSessionCrea
     s->vulkanBinding.next = nullptr;
   }
   s->settings = settingsFromConfig(state->config);
-  // The SDF is built on the CPU for now; the Vulkan backend plugs in behind SdfBackend.
-  s->grasp = std::make_unique<GraspSession>(makeCpuSdfBackend(2));
+  // Vulkan sessions build on the app's device (vulkan.cpp); the CPU builder is the fallback and
+  // the path of every other session.
+  std::unique_ptr<DeferredSdfBackend> gpu;
+  if (s->vulkan && state->appAutoGrasp) gpu = makeVulkanBackend(*s);
+  s->grasp = std::make_unique<GraspSession>(makeCpuSdfBackend(2), std::move(gpu));
   if (Status st = s->grasp->configure(s->settings); st != Status::ok) {
     SDFG_LOG_WARN(cmd, "configured solver '%s' is not usable (%s); using 'paper'",
                   s->settings.solver.c_str(), toString(st));
@@ -92,6 +95,9 @@ XrResult XRAPI_CALL SdfgXrDestroySession(XrSession session) {
   {
     std::lock_guard lock(s->mutex);
     destroyInternalTrackers(*s);
+    // GPU work first: waits for builds in flight and frees the layer's objects on the app's
+    // device while it surely exists (the app destroys it after the session).
+    dropGpuWork(*s);
   }
   const XrResult r = s->instance->next.xrDestroySession(session);
   if (XR_SUCCEEDED(r)) {

@@ -18,6 +18,10 @@
 #include "hand_synthesis.h"
 #include "xr_includes.h"
 
+namespace sdfg {
+class VkGraspBackend;
+}
+
 namespace sdfg::layer {
 
 inline constexpr const char* kLayerName = "XR_APILAYER_SDFG_autograsp";
@@ -81,6 +85,18 @@ struct InstanceState {
   std::vector<ProfilePaths> profiles;     // resolved when the actions are created
   std::mutex inputMutex;                  // guards the fields below
   std::set<XrPath> appSuggestedProfiles;  // profiles the app suggested bindings for
+
+  // XR_KHR_vulkan_enable2: what the app's xrCreateVulkanInstanceKHR / xrCreateVulkanDeviceKHR
+  // passed, and the queue the layer added to a device (see vulkan.cpp).
+  bool appVulkan2 = false;
+  struct ExtraQueue {
+    uint32_t family = 0;
+    uint32_t index = 0;
+  };
+  std::mutex vulkanMutex;                                              // guards the fields below
+  std::unordered_map<uint64_t, PFN_vkGetInstanceProcAddr> vulkanGipa;  // by VkInstance
+  VkInstance lastVulkanInstance = VK_NULL_HANDLE;
+  std::unordered_map<uint64_t, ExtraQueue> extraQueues;  // by VkDevice
 };
 
 struct TargetState;
@@ -100,6 +116,9 @@ struct SessionState {
   std::array<float, 2> squeeze{};
   std::array<XrHandTrackerEXT, 2> internalTrackers{};  // the layer's own, on the runtime
   std::unique_ptr<GraspSession> grasp;
+  // The Vulkan backend inside `grasp` (null: CPU only), and whether it has a queue of its own.
+  VkGraspBackend* vulkanBackend = nullptr;
+  bool ownQueue = false;
   GraspSettings settings;
   std::unordered_map<uint64_t, std::shared_ptr<TargetState>> targets;
 };
@@ -117,6 +136,8 @@ struct TargetState {
   XrSpace space = XR_NULL_HANDLE;
   XrPosef pose{};
   uint32_t vertexCount = 0;
+  uint32_t indexCount = 0;
+  bool deviceBuffers = false;  // the mesh is the app's Vulkan buffers
 };
 
 template <class T>
@@ -143,6 +164,11 @@ class HandleMap {
   std::shared_ptr<T> any() const {
     std::lock_guard lock(mutex_);
     return map_.empty() ? nullptr : map_.begin()->second;
+  }
+  template <class F>
+  void forEach(F f) const {
+    std::lock_guard lock(mutex_);
+    for (const auto& kv : map_) f(kv.second);
   }
   template <class Pred>
   void eraseIf(Pred pred) {
@@ -189,6 +215,18 @@ std::string resolveSolverName(const std::string& name);
 
 // Runs the layer's grab update for both hands after the app's xrSyncActions.
 void updateGrasps(SessionState& session);
+
+// vulkan.cpp: the Vulkan SDF backend for a session created with a Vulkan binding (null when the
+// layer is built without it, the config says gpu = false, or the device cannot be used; the
+// reason is logged). Sets session.vulkanBackend and session.ownQueue.
+std::unique_ptr<DeferredSdfBackend> makeVulkanBackend(SessionState& session);
+// Hands the session's recorded GPU builds to the device: `inFrame` inside xrBeginFrame /
+// xrEndFrame (the app's queue is free), else only builds for the layer's own queue. Holds no
+// lock: the caller holds session.mutex.
+void submitGpuWork(SessionState& session, bool inFrame, const char* cmd);
+// Ends the session's GPU path: waits (bounded) for builds in flight and frees the layer's Vulkan
+// objects; the session continues on the CPU. The caller holds session.mutex.
+void dropGpuWork(SessionState& session);
 
 }  // namespace sdfg::layer
 

@@ -44,7 +44,9 @@ std::optional<Error> GraspSettings::validate() const {
   return std::nullopt;
 }
 
-GraspSession::GraspSession(std::unique_ptr<SdfBackend> backend) : backend_(std::move(backend)) {
+GraspSession::GraspSession(std::unique_ptr<SdfBackend> backend,
+                           std::unique_ptr<DeferredSdfBackend> deferred)
+    : backend_(std::move(backend)), deferred_(std::move(deferred)) {
   hands_[0].model = HandModel::defaultAdult(Hand::left);
   hands_[1].model = HandModel::defaultAdult(Hand::right);
   (void)configure(settings_);
@@ -63,6 +65,8 @@ Status GraspSession::configure(const GraspSettings& settings) {
   }
   settings_ = settings;
   for (size_t h = 0; h < 2; ++h) {
+    // A build in flight was made for the old box: drop it, a held hand asks again.
+    cancelPending(hands_[h], h);
     hands_[h].solver = std::move(solvers[h]);
     hands_[h].prepared = false;
   }
@@ -80,9 +84,59 @@ Status GraspSession::addTarget(uint64_t id, const TriangleMesh& mesh) {
   return Status::ok;
 }
 
-Status GraspSession::updateTargetVertices(uint64_t id, std::span<const glm::vec3> positions) {
+Status GraspSession::addDeviceTarget(uint64_t id, const Aabb& bounds) {
+  if (targets_.count(id) != 0) return Status::invalid_argument;
+  for (int a = 0; a < 3; ++a) {
+    if (!std::isfinite(bounds.min[a]) || !std::isfinite(bounds.max[a]) ||
+        !(bounds.min[a] <= bounds.max[a]))
+      return Status::invalid_argument;
+  }
+  if (!deferredUsable() || !deferred_->hasDeviceMesh(id)) return Status::unsupported;
+  Target t;
+  t.bounds = bounds;
+  targets_.emplace(id, std::move(t));
+  return Status::ok;
+}
+
+Status GraspSession::updateTargetBounds(uint64_t id, const Aabb& bounds) {
+  auto it = targets_.find(id);
+  if (it == targets_.end() || it->second.distance != nullptr) return Status::invalid_argument;
+  for (int a = 0; a < 3; ++a) {
+    if (!std::isfinite(bounds.min[a]) || !std::isfinite(bounds.max[a]) ||
+        !(bounds.min[a] <= bounds.max[a]))
+      return Status::invalid_argument;
+  }
+  it->second.bounds = bounds;
+  return Status::ok;
+}
+
+Status GraspSession::touchTarget(uint64_t id) {
   auto it = targets_.find(id);
   if (it == targets_.end()) return Status::invalid_argument;
+  ++it->second.version;
+  return Status::ok;
+}
+
+Status GraspSession::submitDeferred(bool sharedQueueFree) {
+  if (!deferredUsable()) return Status::ok;
+  const Status s = deferred_->submit(sharedQueueFree);
+  if (deferred_->failed()) stats_.gpuFailed = true;
+  return s;
+}
+
+void GraspSession::dropDeferred() {
+  for (size_t h = 0; h < 2; ++h) hands_[h].pending = false;
+  deferred_.reset();
+}
+
+void GraspSession::cancelPending(HandState& hand, size_t slot) {
+  if (hand.pending && deferred_ != nullptr) deferred_->cancel(slot);
+  hand.pending = false;
+}
+
+Status GraspSession::updateTargetVertices(uint64_t id, std::span<const glm::vec3> positions) {
+  auto it = targets_.find(id);
+  if (it == targets_.end() || it->second.distance == nullptr) return Status::invalid_argument;
   if (Status s = it->second.distance->updatePositions(positions); s != Status::ok) return s;
   it->second.bounds = computeBounds(positions);
   ++it->second.version;
@@ -90,13 +144,17 @@ Status GraspSession::updateTargetVertices(uint64_t id, std::span<const glm::vec3
 }
 
 bool GraspSession::removeTarget(uint64_t id) {
-  for (HandState& h : hands_) {
-    if (h.grasp.holding && h.grasp.target == id) h.grasp = HandGrasp{};
+  for (size_t h = 0; h < 2; ++h) {
+    if (hands_[h].grasp.holding && hands_[h].grasp.target == id) {
+      cancelPending(hands_[h], h);
+      hands_[h].grasp = HandGrasp{};
+    }
   }
   return targets_.erase(id) != 0;
 }
 
 void GraspSession::release(Hand hand) {
+  cancelPending(hands_[size_t(hand)], size_t(hand));
   hands_[size_t(hand)].grasp = HandGrasp{};
 }
 
@@ -128,16 +186,39 @@ std::optional<uint64_t> GraspSession::pickTarget(const Pose& worldFromWrist,
   return best;
 }
 
-Status GraspSession::solve(HandState& hand, const Target& target, const Pose& objectFromHand) {
+Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Target& target,
+                           const Pose& objectFromHand) {
   if (!hand.prepared) {
     if (Status s = hand.solver->prepare(hand.model, settings_.box, settings_.solverOptions);
         s != Status::ok)
       return s;
     hand.prepared = true;
   }
+  if (deferredUsable()) {
+    const TriangleMesh* mesh = target.distance ? &target.distance->mesh() : nullptr;
+    const Status s =
+        deferred_->request(slot, id, target.version, mesh, objectFromHand, settings_.box);
+    if (s == Status::ok) {
+      hand.pending = true;
+      hand.pendingPose = objectFromHand;
+      hand.pendingVersion = target.version;
+      return Status::ok;
+    }
+    // Busy with a cancelled build still on the device: ask again at the next update.
+    if (s == Status::unsupported) return Status::ok;
+    if (s == Status::invalid_argument) return s;
+    stats_.gpuFailed = true;  // the device failed: this and every later build on the CPU
+  }
+  if (target.distance == nullptr) return Status::device_lost;
   if (Status s = backend_->build(*target.distance, objectFromHand, settings_.box, hand.grid);
       s != Status::ok)
     return s;
+  ++stats_.cpuBuilds;
+  return solveWithGrid(hand, objectFromHand, target.version, false);
+}
+
+Status GraspSession::solveWithGrid(HandState& hand, const Pose& objectFromHand, uint64_t version,
+                                   bool gpu) {
   GraspScene scene;
   scene.field = &hand.grid;
   scene.objectFromHand = objectFromHand;
@@ -145,41 +226,81 @@ Status GraspSession::solve(HandState& hand, const Target& target, const Pose& ob
   if (Status s = hand.solver->solve(scene, result); s != Status::ok) return s;
   hand.grasp.result = result;
   hand.grasp.objectFromHand = objectFromHand;
-  hand.solvedVersion = target.version;
+  hand.grasp.builtOnGpu = gpu;
+  hand.solvedVersion = version;
   ++hand.grasp.solves;
   return Status::ok;
 }
 
+Status GraspSession::collect(HandState& hand, size_t slot) {
+  if (!hand.pending) return Status::ok;
+  if (deferred_ == nullptr) {
+    hand.pending = false;
+    return Status::ok;
+  }
+  const BuildPoll p = deferred_->poll(slot, hand.grid);
+  if (p == BuildPoll::pending) return Status::ok;
+  hand.pending = false;
+  auto it = hand.grasp.holding ? targets_.find(hand.grasp.target) : targets_.end();
+  if (it == targets_.end()) return Status::ok;
+  if (p == BuildPoll::ready) {
+    ++stats_.gpuBuilds;
+    // A result for older vertices is still shown; the next update asks again.
+    return solveWithGrid(hand, hand.pendingPose, hand.pendingVersion, true);
+  }
+  // The device failed (or lost the request): redo the build on the CPU now.
+  if (p == BuildPoll::failed) stats_.gpuFailed = true;
+  if (it->second.distance == nullptr) {
+    hand.grasp = HandGrasp{};
+    return Status::device_lost;
+  }
+  if (Status s = backend_->build(*it->second.distance, hand.pendingPose, settings_.box, hand.grid);
+      s != Status::ok) {
+    hand.grasp = HandGrasp{};
+    return s;
+  }
+  ++stats_.cpuBuilds;
+  return solveWithGrid(hand, hand.pendingPose, hand.pendingVersion, false);
+}
+
 Status GraspSession::update(Hand side, const HandFrame& frame,
                             std::span<const TargetFrame> targets) {
-  HandState& hand = hands_[size_t(side)];
+  const size_t slot = size_t(side);
+  HandState& hand = hands_[slot];
   hand.squeeze = std::isfinite(frame.squeeze) ? frame.squeeze : 0.0f;
+  const Status collected = collect(hand, slot);
   if (hand.grasp.holding) {
     auto it = targets_.find(hand.grasp.target);
     if (it == targets_.end() || hand.squeeze < settings_.grabThreshold * settings_.releaseRatio) {
+      cancelPending(hand, slot);
       hand.grasp = HandGrasp{};
-      return Status::ok;
+      return collected;
     }
     const TargetFrame* located = nullptr;
     for (const TargetFrame& t : targets) {
       if (t.id == hand.grasp.target && t.valid) located = &t;
     }
-    if (!frame.valid || located == nullptr) return Status::ok;  // keep the last solve
+    if (!frame.valid || located == nullptr) return collected;  // keep the last solve
+    if (hand.pending) return collected;  // the build in flight first, then re-check
     const Pose objectFromHand = located->worldFromObject.inverse() * frame.worldFromWrist;
     const bool moved =
         glm::length(objectFromHand.position - hand.grasp.objectFromHand.position) >
             settings_.moveTolerance ||
         angleBetween(objectFromHand.orientation, hand.grasp.objectFromHand.orientation) >
             settings_.turnTolerance;
-    if (!moved && hand.solvedVersion == it->second.version) return Status::ok;
-    const Status s = solve(hand, it->second, objectFromHand);
-    if (s != Status::ok) hand.grasp = HandGrasp{};
+    if (hand.grasp.solves > 0 && !moved && hand.solvedVersion == it->second.version)
+      return collected;
+    const Status s = solve(hand, slot, it->first, it->second, objectFromHand);
+    if (s != Status::ok) {
+      cancelPending(hand, slot);
+      hand.grasp = HandGrasp{};
+    }
     return s;
   }
 
-  if (!frame.valid || hand.squeeze < settings_.grabThreshold) return Status::ok;
+  if (!frame.valid || hand.squeeze < settings_.grabThreshold) return collected;
   const std::optional<uint64_t> id = pickTarget(frame.worldFromWrist, targets);
-  if (!id) return Status::ok;
+  if (!id) return collected;
   const Target& target = targets_.at(*id);
   const TargetFrame* located = nullptr;
   for (const TargetFrame& t : targets) {
@@ -196,8 +317,12 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   hand.grasp = HandGrasp{};
   hand.grasp.holding = true;
   hand.grasp.target = *id;
-  const Status s = solve(hand, target, located->worldFromObject.inverse() * frame.worldFromWrist);
-  if (s != Status::ok) hand.grasp = HandGrasp{};
+  const Status s =
+      solve(hand, slot, *id, target, located->worldFromObject.inverse() * frame.worldFromWrist);
+  if (s != Status::ok) {
+    cancelPending(hand, slot);
+    hand.grasp = HandGrasp{};
+  }
   return s;
 }
 

@@ -356,8 +356,10 @@ Result<std::unique_ptr<VkSdfBuilder>> VkSdfBuilder::create(const VulkanDevice& d
 
 VkSdfBuilder::~VkSdfBuilder() {
   if (!ctx_ || !objects_) return;
-  if (pending_ && !failed_) {
+  if (pending_) {
     // The GPU may still read our buffers; destroying them first would be undefined behaviour.
+    // Also after a failure: a simulated loss (or one reported by a poll while the submission
+    // still runs) leaves real work in flight; on a lost device the wait returns at once.
     const VkFence fence = objects_->fence.get();
     const VkResult r =
         ctx_->fn().vkWaitForFences(ctx_->handle(), 1, &fence, VK_TRUE, 2'000'000'000ull);

@@ -40,6 +40,7 @@ XR_DEFINE_HANDLE(XrGraspTargetSDFG)
 #define XR_TYPE_GRASP_STATE_SDFG ((XrStructureType)1009900004)
 #define XR_TYPE_GRASP_OPTIONS_SDFG ((XrStructureType)1009900005)
 #define XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG ((XrStructureType)1009900006)
+#define XR_TYPE_GRASP_BUILD_INFO_SDFG ((XrStructureType)1009900007)
 #define XR_OBJECT_TYPE_GRASP_TARGET_SDFG ((XrObjectType)1009900000)
 
 // Limits, so a stray count cannot exhaust memory.
@@ -71,22 +72,38 @@ typedef struct XrGraspTargetVerticesSDFG {
 } XrGraspTargetVerticesSDFG;
 
 #ifdef XR_USE_GRAPHICS_API_VULKAN
-// Mesh as Vulkan buffers of the session's VkDevice (a skinned mesh the app already writes on
-// the GPU). Vertex i's position is 3 floats at vertexOffset + i * vertexStride bytes; indices
-// are uint32 at indexOffset. The buffers must be created with VK_BUFFER_USAGE_STORAGE_BUFFER_BIT
-// and outlive the target; the app's writes must be complete (by a queue submission the layer's
-// work follows) before the xrSyncActions that samples them. Sessions without a Vulkan binding
-// return XR_ERROR_GRAPHICS_DEVICE_INVALID.
+// Mesh as Vulkan buffers of the session's VkDevice (a skinned mesh the app already writes on the
+// GPU), read by the layer's compute work at every build; nothing is copied to the CPU. Only on a
+// session created with XrGraphicsBindingVulkanKHR (or ...Vulkan2KHR) whose SDFs are built on the
+// GPU; otherwise XR_ERROR_GRAPHICS_DEVICE_INVALID (no Vulkan binding) or
+// XR_ERROR_FEATURE_UNSUPPORTED (the session builds on the CPU: gpu = false, no usable device, or
+// after a GPU failure).
+// - Vertex i's position is 3 floats (x, y, z, metres, target frame) at
+//   vertexOffset + i * vertexStride bytes of vertexBuffer; other attributes may sit between.
+// - Index k is a uint16 or uint32 (indexType) at indexOffset + k * index size bytes.
+// - Both buffers need VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, must be usable on the binding's queue
+//   family (exclusive to it, or concurrent), and must stay alive until the target is destroyed
+//   (xrDestroyGraspTargetSDFG waits for the layer's reads in flight) or replaced by an update.
+// - Writes: the layer reads the buffers in command buffers it submits on the binding's queue
+//   inside xrBeginFrame / xrEndFrame. Submit the commands that write them (skinning) on that
+//   queue before the xrEndFrame of the frame whose xrSyncActions should see them, and do not
+//   write them from another queue without waiting for the frame's work.
+// - Index values out of range, and triangles with a non-finite corner, are skipped by the GPU.
+// - bounds: an axis-aligned box in the target frame that holds the mesh at all times (for a
+//   skinned mesh, over its whole animation): it decides whether the target is in a grab box.
 typedef struct XrGraspTargetVulkanBuffersSDFG {
   XrStructureType type;  // XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG
   const void* XR_MAY_ALIAS next;
   VkBuffer vertexBuffer;
-  VkDeviceSize vertexOffset;
-  uint32_t vertexStride;  // bytes, >= 12 and a multiple of 4
-  uint32_t vertexCount;
+  VkDeviceSize vertexOffset;  // bytes, a multiple of 4
+  uint32_t vertexStride;      // bytes, >= 12 and a multiple of 4
+  uint32_t vertexCount;       // 3..XR_MAX_GRASP_TARGET_VERTICES_SDFG
   VkBuffer indexBuffer;
-  VkDeviceSize indexOffset;
-  uint32_t indexCount;
+  VkDeviceSize indexOffset;  // bytes, a multiple of the index size
+  VkIndexType indexType;     // VK_INDEX_TYPE_UINT16 or VK_INDEX_TYPE_UINT32
+  uint32_t indexCount;       // a multiple of 3, 3..XR_MAX_GRASP_TARGET_INDICES_SDFG
+  XrVector3f boundsMin;      // target frame, metres; each component <= boundsMax's
+  XrVector3f boundsMax;
 } XrGraspTargetVulkanBuffersSDFG;
 #endif
 
@@ -121,6 +138,26 @@ typedef struct XrGraspStateSDFG {
   XrGraspFingerStateSDFG fingers[XR_GRASP_FINGER_COUNT_SDFG];
 } XrGraspStateSDFG;
 
+// Where a grab-box SDF was built.
+typedef enum XrGraspSdfBackendSDFG {
+  XR_GRASP_SDF_BACKEND_NONE_SDFG = 0,    // nothing built (not grasping)
+  XR_GRASP_SDF_BACKEND_CPU_SDFG = 1,     // the layer's CPU builder
+  XR_GRASP_SDF_BACKEND_VULKAN_SDFG = 2,  // compute work on the session's Vulkan device
+  XR_GRASP_SDF_BACKEND_MAX_ENUM_SDFG = 0x7FFFFFFF
+} XrGraspSdfBackendSDFG;
+
+// Optional output, chained on XrGraspStateSDFG::next: where the SDFs of the session are built.
+typedef struct XrGraspBuildInfoSDFG {
+  XrStructureType type;  // XR_TYPE_GRASP_BUILD_INFO_SDFG
+  void* XR_MAY_ALIAS next;
+  XrGraspSdfBackendSDFG graspBackend;    // of the hand's shown grasp; NONE when not grasping
+  XrGraspSdfBackendSDFG sessionBackend;  // where the session's next build goes
+  uint64_t gpuBuildCount;                // builds of the session done on the GPU so far
+  uint64_t cpuBuildCount;                // and on the CPU
+  XrBool32 gpuFailed;  // the GPU path failed (device lost or any Vulkan error): CPU from then on
+  uint32_t pendingGpuBuilds;  // GPU builds requested and not yet collected (0..2)
+} XrGraspBuildInfoSDFG;
+
 // Solver strategies; the layer's configuration picks the default.
 typedef enum XrGraspSolverSDFG {
   XR_GRASP_SOLVER_DEFAULT_SDFG = 0,  // the configured strategy (see docs/layer.md)
@@ -147,8 +184,11 @@ typedef XrResult(XRAPI_PTR* PFN_xrCreateGraspTargetSDFG)(
     XrSession session, const XrGraspTargetCreateInfoSDFG* createInfo, XrGraspTargetSDFG* target);
 typedef XrResult(XRAPI_PTR* PFN_xrDestroyGraspTargetSDFG)(XrGraspTargetSDFG target);
 // New vertex positions (same count, same topology): animated and skinned meshes. Pass an
-// XrGraspTargetVerticesSDFG with indexCount 0 (CPU targets), or an
-// XrGraspTargetVulkanBuffersSDFG (the layer re-reads the buffers; same counts).
+// XrGraspTargetVerticesSDFG with indexCount 0 (array targets), or an
+// XrGraspTargetVulkanBuffersSDFG (buffer targets: the app says its buffers changed; the
+// buffers, offsets, stride, index type and bounds may change, the counts may not). A held target
+// is solved again from the next xrSyncActions. The wrong kind for the target:
+// XR_ERROR_VALIDATION_FAILURE.
 typedef XrResult(XRAPI_PTR* PFN_xrUpdateGraspTargetVerticesSDFG)(XrGraspTargetSDFG target,
                                                                  const void* vertices);
 typedef XrResult(XRAPI_PTR* PFN_xrSetGraspTargetPlacementSDFG)(

@@ -10,109 +10,13 @@
 #include <map>
 #include <sstream>
 
+#include "grasp_checks.h"
 #include "test_scenes.h"
 #include "xr_harness.h"
 
 namespace {
 
 using namespace sdfg::test;
-
-struct Ext {
-  PFN_xrCreateGraspTargetSDFG create;
-  PFN_xrDestroyGraspTargetSDFG destroy;
-  PFN_xrGetGraspStateSDFG state;
-  PFN_xrCreateHandTrackerEXT createTracker;
-  explicit Ext(const App& app)
-      : create(app.fn<PFN_xrCreateGraspTargetSDFG>("xrCreateGraspTargetSDFG")),
-        destroy(app.fn<PFN_xrDestroyGraspTargetSDFG>("xrDestroyGraspTargetSDFG")),
-        state(app.fn<PFN_xrGetGraspStateSDFG>("xrGetGraspStateSDFG")),
-        createTracker(app.fn<PFN_xrCreateHandTrackerEXT>("xrCreateHandTrackerEXT")) {}
-};
-
-XrHandTrackerEXT makeTracker(const App& app, const Ext& ext, XrHandEXT hand) {
-  XrHandTrackerCreateInfoEXT ci{XR_TYPE_HAND_TRACKER_CREATE_INFO_EXT};
-  ci.hand = hand;
-  ci.handJointSet = XR_HAND_JOINT_SET_DEFAULT_EXT;
-  XrHandTrackerEXT t = XR_NULL_HANDLE;
-  REQUIRE(ext.createTracker(app.session, &ci, &t) == XR_SUCCESS);
-  return t;
-}
-
-XrGraspTargetSDFG makeTarget(const App& app, const Ext& ext, const TestMesh& mesh,
-                             const XrPosef& pose) {
-  XrGraspTargetVerticesSDFG v{XR_TYPE_GRASP_TARGET_VERTICES_SDFG};
-  v.vertexCount = uint32_t(mesh.vertices.size());
-  v.vertices = mesh.vertices.data();
-  v.indexCount = uint32_t(mesh.indices.size());
-  v.indices = mesh.indices.data();
-  XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &v};
-  ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, app.local, pose};
-  XrGraspTargetSDFG t = XR_NULL_HANDLE;
-  REQUIRE(ext.create(app.session, &ci, &t) == XR_SUCCESS);
-  return t;
-}
-
-float length(const XrVector3f& v) {
-  return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
-}
-XrVector3f sub(const XrVector3f& a, const XrVector3f& b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-
-constexpr int kTips[5] = {XR_HAND_JOINT_THUMB_TIP_EXT, XR_HAND_JOINT_INDEX_TIP_EXT,
-                          XR_HAND_JOINT_MIDDLE_TIP_EXT, XR_HAND_JOINT_RING_TIP_EXT,
-                          XR_HAND_JOINT_LITTLE_TIP_EXT};
-
-// Runs a controller-only scene: the hand squeezes from frame 4; returns the located joints and
-// the grasp state after `frames` frames. `distance` is the exact signed distance of the object
-// in LOCAL space.
-struct GraspOutcome {
-  Joints joints;
-  XrGraspStateSDFG state{XR_TYPE_GRASP_STATE_SDFG};
-  int contacts = 0;
-};
-
-// Clearance of a finger's surface model: the capsules between its located joints, from the
-// proximal joint to the tip, radii interpolated between the joints' radii. Negative inside.
-float fingerClearance(const GraspOutcome& out, int finger,
-                      const std::function<float(const XrVector3f&)>& distance) {
-  const int first = finger == 0 ? XR_HAND_JOINT_THUMB_PROXIMAL_EXT : kTips[finger] - 3;
-  float best = std::numeric_limits<float>::infinity();
-  for (int j = first; j < kTips[finger]; ++j) {
-    const XrHandJointLocationEXT& a = out.joints.joints[j];
-    const XrHandJointLocationEXT& b = out.joints.joints[j + 1];
-    constexpr int kSteps = 8;
-    for (int s = 0; s <= kSteps; ++s) {
-      const float t = float(s) / kSteps;
-      const XrVector3f p{a.pose.position.x + t * (b.pose.position.x - a.pose.position.x),
-                         a.pose.position.y + t * (b.pose.position.y - a.pose.position.y),
-                         a.pose.position.z + t * (b.pose.position.z - a.pose.position.z)};
-      best = std::min(best, distance(p) - (a.radius + t * (b.radius - a.radius)));
-    }
-  }
-  return best;
-}
-
-void checkContacts(const GraspOutcome& out,
-                   const std::function<float(const XrVector3f&)>& distance) {
-  REQUIRE(out.joints.locations.isActive);
-  REQUIRE(out.state.isGrasping);
-  int contacts = 0;
-  for (int f = 0; f < 5; ++f) {
-    const XrHandJointLocationEXT& tip = out.joints.joints[kTips[f]];
-    const float d = distance(tip.pose.position);
-    const float clearance = fingerClearance(out, f, distance);
-    CAPTURE(f, d, tip.radius, clearance, out.state.fingers[f].curl);
-    // No tip inside the object, in contact or not.
-    CHECK(d > 0.0f);
-    if (!out.state.fingers[f].inContact) continue;
-    ++contacts;
-    // The finger touches the surface (with its tip, or its pad for whole-finger strategies):
-    // its closest part ends within 2 mm of it, on either side.
-    CHECK(std::abs(clearance) <= 0.002f);
-  }
-  CHECK(contacts >= 3);
-}
 
 GraspOutcome graspScene(const TestMesh& mesh, const XrPosef& objectPose, const XrPosef& grip,
                         const char* hand = "right", uint32_t resolution = 0) {

@@ -2,8 +2,15 @@
 // identity, and an app that never enables the extension.
 #include <dlfcn.h>
 
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <iterator>
+#include <string>
 
 #include "xr_harness.h"
 
@@ -189,5 +196,44 @@ TEST_CASE("With no grasp active, the app's joints are bit-identical to the runti
   }
   REQUIRE(with.size() == without.size());
   CHECK(std::memcmp(with.data(), without.data(), with.size()) == 0);
+  CHECK(validationLog().empty());
+}
+
+// The layer asks the chain for the runtime's extensions before creating the instance (stepping
+// over core validation, which misreports a query without an instance), so a runtime without
+// hand tracking is never sent a list it refuses. Before, the refused first attempt made core
+// validation 1.0.20 print "INTERNAL VALIDATION LAYER ERROR" on stderr.
+TEST_CASE("On a runtime without hand tracking the instance is created at the first attempt",
+          "[layer][loading]") {
+  XrEnv env;
+  env.handTracking = "absent";
+  env.extra = {{"SDFG_AUTOGRASP_LOG_LEVEL", "info"}};
+  applyEnv(env);
+  // Core validation writes its internal errors, and the layer its log, to stderr: capture it.
+  char path[] = "/tmp/sdfg_layer_stderr_XXXXXX";
+  const int fd = mkstemp(path);
+  REQUIRE(fd >= 0);
+  std::fflush(stderr);
+  const int saved = dup(2);
+  dup2(fd, 2);
+  bool ok = false;
+  {
+    App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}});
+    ok = app.ok();
+  }
+  std::fflush(stderr);
+  dup2(saved, 2);
+  close(saved);
+  close(fd);
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::remove(path);
+  unsetenv("SDFG_AUTOGRASP_LOG_LEVEL");
+  CAPTURE(text);
+  REQUIRE(ok);
+  CHECK(text.find("INTERNAL VALIDATION LAYER ERROR") == std::string::npos);
+  // One create call went down, without hand tracking.
+  CHECK(text.find("create with hand tracking 0, motion range 0: 0") != std::string::npos);
+  CHECK(text.find("create with hand tracking 1") == std::string::npos);
   CHECK(validationLog().empty());
 }

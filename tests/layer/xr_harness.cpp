@@ -14,6 +14,44 @@ namespace {
 
 std::string gWorkDir;
 
+std::vector<std::string>& messageStore() {
+  static std::vector<std::string> messages;
+  return messages;
+}
+
+VKAPI_ATTR VkBool32 VKAPI_CALL onVulkanMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                               VkDebugUtilsMessageTypeFlagsEXT,
+                                               const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                               void*) {
+  if (severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) {
+    messageStore().push_back(data->pMessage);
+    std::fprintf(stderr, "vulkan validation: %s\n", data->pMessage);
+  }
+  return VK_FALSE;
+}
+
+VkDebugUtilsMessengerCreateInfoEXT messengerInfo() {
+  VkDebugUtilsMessengerCreateInfoEXT mi{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+  mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                   VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                   VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+  mi.pfnUserCallback = &onVulkanMessage;
+  return mi;
+}
+
+std::vector<const char*> splitNames(std::string& text) {
+  std::vector<const char*> out;
+  for (char& c : text) {
+    if (c == ' ') c = '\0';
+  }
+  for (size_t i = 0; i < text.size(); ++i) {
+    if (text[i] != '\0' && (i == 0 || text[i - 1] == '\0')) out.push_back(&text[i]);
+  }
+  return out;
+}
+
 std::string workDir() {
   if (gWorkDir.empty()) {
     char tmpl[] = "/tmp/sdfg_layer_test_XXXXXX";
@@ -53,6 +91,10 @@ std::string applyEnv(const XrEnv& env) {
   } else {
     unsetenv("SDFG_MOCK_SCRIPT");
   }
+  // Layer settings a previous test may have set.
+  unsetenv("SDFG_AUTOGRASP_GPU");
+  unsetenv("SDFG_AUTOGRASP_EXTRA_QUEUE");
+  unsetenv("SDFG_AUTOGRASP_TEST_GPU_FAULT");
   for (const auto& [k, v] : env.extra) setenv(k.c_str(), v.c_str(), 1);
   return cv;
 }
@@ -64,8 +106,194 @@ std::string validationLog() {
   return s.str();
 }
 
+std::vector<std::string> vulkanMessages() {
+  return messageStore();
+}
+
+std::string vulkanUnavailable() {
+  uint32_t count = 0;
+  if (vkEnumerateInstanceLayerProperties(&count, nullptr) != VK_SUCCESS) return "no Vulkan loader";
+  std::vector<VkLayerProperties> layers(count);
+  vkEnumerateInstanceLayerProperties(&count, layers.data());
+  bool validation = false;
+  for (const auto& l : layers)
+    validation |= std::strcmp(l.layerName, "VK_LAYER_KHRONOS_validation") == 0;
+  if (!validation) return "the Khronos Vulkan validation layer is not installed";
+  VkApplicationInfo ai{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  ai.apiVersion = VK_API_VERSION_1_1;
+  VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  ci.pApplicationInfo = &ai;
+  VkInstance instance = VK_NULL_HANDLE;
+  if (vkCreateInstance(&ci, nullptr, &instance) != VK_SUCCESS) return "vkCreateInstance failed";
+  uint32_t devices = 0;
+  vkEnumeratePhysicalDevices(instance, &devices, nullptr);
+  vkDestroyInstance(instance, nullptr);
+  return devices == 0 ? "no Vulkan physical device" : "";
+}
+
+HostBuffer App::createBuffer(VkDeviceSize bytes) {
+  HostBuffer b;
+  VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  bi.size = bytes;
+  bi.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  if (vkCreateBuffer(vk.device, &bi, nullptr, &b.buffer) != VK_SUCCESS) return {};
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(vk.device, b.buffer, &req);
+  VkPhysicalDeviceMemoryProperties mem;
+  vkGetPhysicalDeviceMemoryProperties(vk.physicalDevice, &mem);
+  const VkMemoryPropertyFlags want =
+      VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  uint32_t type = 0;
+  while (type < mem.memoryTypeCount && (!(req.memoryTypeBits & (1u << type)) ||
+                                        (mem.memoryTypes[type].propertyFlags & want) != want))
+    ++type;
+  VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  ai.allocationSize = req.size;
+  ai.memoryTypeIndex = type;
+  if (type == mem.memoryTypeCount ||
+      vkAllocateMemory(vk.device, &ai, nullptr, &b.memory) != VK_SUCCESS ||
+      vkBindBufferMemory(vk.device, b.buffer, b.memory, 0) != VK_SUCCESS ||
+      vkMapMemory(vk.device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped) != VK_SUCCESS) {
+    if (b.memory != VK_NULL_HANDLE) vkFreeMemory(vk.device, b.memory, nullptr);
+    vkDestroyBuffer(vk.device, b.buffer, nullptr);
+    return {};
+  }
+  buffers_.push_back(b);
+  return b;
+}
+
+bool App::setUpVulkan(Graphics graphics) {
+  const bool two = graphics == Graphics::vulkan2;
+  const char* layer = "VK_LAYER_KHRONOS_validation";
+  VkApplicationInfo appInfo{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  appInfo.apiVersion = VK_API_VERSION_1_1;
+  VkDebugUtilsMessengerCreateInfoEXT mi = messengerInfo();
+  VkResult vr = VK_ERROR_UNKNOWN;
+  if (two) {
+    XrGraphicsRequirementsVulkan2KHR req{XR_TYPE_GRAPHICS_REQUIREMENTS_VULKAN2_KHR};
+    if (fn<PFN_xrGetVulkanGraphicsRequirements2KHR>("xrGetVulkanGraphicsRequirements2KHR")(
+            instance, system, &req) != XR_SUCCESS)
+      return false;
+    const char* extension = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+    VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO, &mi};
+    ici.pApplicationInfo = &appInfo;
+    ici.enabledLayerCount = 1;
+    ici.ppEnabledLayerNames = &layer;
+    ici.enabledExtensionCount = 1;
+    ici.ppEnabledExtensionNames = &extension;
+    XrVulkanInstanceCreateInfoKHR xi{XR_TYPE_VULKAN_INSTANCE_CREATE_INFO_KHR};
+    xi.systemId = system;
+    xi.pfnGetInstanceProcAddr = &vkGetInstanceProcAddr;
+    xi.vulkanCreateInfo = &ici;
+    if (fn<PFN_xrCreateVulkanInstanceKHR>("xrCreateVulkanInstanceKHR")(instance, &xi, &vk.instance,
+                                                                       &vr) != XR_SUCCESS ||
+        vr != VK_SUCCESS)
+      return false;
+    XrVulkanGraphicsDeviceGetInfoKHR gi{XR_TYPE_VULKAN_GRAPHICS_DEVICE_GET_INFO_KHR};
+    gi.systemId = system;
+    gi.vulkanInstance = vk.instance;
+    if (fn<PFN_xrGetVulkanGraphicsDevice2KHR>("xrGetVulkanGraphicsDevice2KHR")(
+            instance, &gi, &vk.physicalDevice) != XR_SUCCESS)
+      return false;
+  } else {
+    XrGraphicsRequirementsVulkanKHR req{XR_TYPE_GRAPHICS_REQUIREMENTS_VULKAN_KHR};
+    if (fn<PFN_xrGetVulkanGraphicsRequirementsKHR>("xrGetVulkanGraphicsRequirementsKHR")(
+            instance, system, &req) != XR_SUCCESS)
+      return false;
+    auto getExt = fn<PFN_xrGetVulkanInstanceExtensionsKHR>("xrGetVulkanInstanceExtensionsKHR");
+    uint32_t n = 0;
+    getExt(instance, system, 0, &n, nullptr);
+    std::string names(n, '\0');
+    getExt(instance, system, n, &n, names.data());
+    names.resize(std::strlen(names.c_str()));
+    std::vector<const char*> exts = splitNames(names);
+    exts.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO, &mi};
+    ici.pApplicationInfo = &appInfo;
+    ici.enabledLayerCount = 1;
+    ici.ppEnabledLayerNames = &layer;
+    ici.enabledExtensionCount = uint32_t(exts.size());
+    ici.ppEnabledExtensionNames = exts.data();
+    if (vkCreateInstance(&ici, nullptr, &vk.instance) != VK_SUCCESS) return false;
+    if (fn<PFN_xrGetVulkanGraphicsDeviceKHR>("xrGetVulkanGraphicsDeviceKHR")(
+            instance, system, vk.instance, &vk.physicalDevice) != XR_SUCCESS)
+      return false;
+  }
+  auto createMessenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+      vkGetInstanceProcAddr(vk.instance, "vkCreateDebugUtilsMessengerEXT"));
+  if (createMessenger(vk.instance, &mi, nullptr, &vk.messenger) != VK_SUCCESS) return false;
+
+  uint32_t familyCount = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(vk.physicalDevice, &familyCount, nullptr);
+  std::vector<VkQueueFamilyProperties> families(familyCount);
+  vkGetPhysicalDeviceQueueFamilyProperties(vk.physicalDevice, &familyCount, families.data());
+  while (vk.family < familyCount && !(families[vk.family].queueFlags & VK_QUEUE_GRAPHICS_BIT))
+    ++vk.family;
+  if (vk.family == familyCount) return false;
+  const float priority = 0.0f;
+  VkDeviceQueueCreateInfo qi{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  qi.queueFamilyIndex = vk.family;
+  qi.queueCount = 1;
+  qi.pQueuePriorities = &priority;
+  VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  dci.queueCreateInfoCount = 1;
+  dci.pQueueCreateInfos = &qi;
+  if (two) {
+    XrVulkanDeviceCreateInfoKHR xd{XR_TYPE_VULKAN_DEVICE_CREATE_INFO_KHR};
+    xd.systemId = system;
+    xd.pfnGetInstanceProcAddr = &vkGetInstanceProcAddr;
+    xd.vulkanPhysicalDevice = vk.physicalDevice;
+    xd.vulkanCreateInfo = &dci;
+    if (fn<PFN_xrCreateVulkanDeviceKHR>("xrCreateVulkanDeviceKHR")(instance, &xd, &vk.device,
+                                                                   &vr) != XR_SUCCESS ||
+        vr != VK_SUCCESS)
+      return false;
+  } else {
+    auto getExt = fn<PFN_xrGetVulkanDeviceExtensionsKHR>("xrGetVulkanDeviceExtensionsKHR");
+    uint32_t n = 0;
+    getExt(instance, system, 0, &n, nullptr);
+    std::string names(n, '\0');
+    getExt(instance, system, n, &n, names.data());
+    names.resize(std::strlen(names.c_str()));
+    std::vector<const char*> exts = splitNames(names);
+    dci.enabledExtensionCount = uint32_t(exts.size());
+    dci.ppEnabledExtensionNames = exts.empty() ? nullptr : exts.data();
+    if (vkCreateDevice(vk.physicalDevice, &dci, nullptr, &vk.device) != VK_SUCCESS) return false;
+  }
+  vkGetDeviceQueue(vk.device, vk.family, 0, &vk.queue);
+  return true;
+}
+
+void App::destroyVulkan() {
+  if (vk.device != VK_NULL_HANDLE) {
+    vkDeviceWaitIdle(vk.device);
+    for (const HostBuffer& b : buffers_) {
+      vkDestroyBuffer(vk.device, b.buffer, nullptr);
+      vkFreeMemory(vk.device, b.memory, nullptr);
+    }
+    buffers_.clear();
+    // The validation layer reports here any object the layer left on the app's device.
+    vkDestroyDevice(vk.device, nullptr);
+    vk.device = VK_NULL_HANDLE;
+  }
+  if (vk.messenger != VK_NULL_HANDLE) {
+    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(vk.instance, "vkDestroyDebugUtilsMessengerEXT"));
+    destroy(vk.instance, vk.messenger, nullptr);
+    vk.messenger = VK_NULL_HANDLE;
+  }
+  if (vk.instance != VK_NULL_HANDLE) {
+    vkDestroyInstance(vk.instance, nullptr);
+    vk.instance = VK_NULL_HANDLE;
+  }
+}
+
 App::App(const AppOptions& options) {
-  std::vector<const char*> ext{XR_MND_HEADLESS_EXTENSION_NAME};
+  std::vector<const char*> ext{
+      options.graphics == Graphics::headless ? XR_MND_HEADLESS_EXTENSION_NAME
+      : options.graphics == Graphics::vulkan ? XR_KHR_VULKAN_ENABLE_EXTENSION_NAME
+                                             : XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME};
   for (const std::string& e : options.extensions) ext.push_back(e.c_str());
   XrInstanceCreateInfo ci{XR_TYPE_INSTANCE_CREATE_INFO};
   std::strcpy(ci.applicationInfo.applicationName, "sdfg layer test");
@@ -78,6 +306,16 @@ App::App(const AppOptions& options) {
   if (xrGetSystem(instance, &sgi, &system) != XR_SUCCESS) return;
   XrSessionCreateInfo sci{XR_TYPE_SESSION_CREATE_INFO};
   sci.systemId = system;
+  XrGraphicsBindingVulkanKHR binding{XR_TYPE_GRAPHICS_BINDING_VULKAN_KHR};
+  if (options.graphics != Graphics::headless) {
+    if (!setUpVulkan(options.graphics)) return;
+    binding.instance = vk.instance;
+    binding.physicalDevice = vk.physicalDevice;
+    binding.device = vk.device;
+    binding.queueFamilyIndex = vk.family;
+    binding.queueIndex = 0;
+    sci.next = &binding;
+  }
   if (xrCreateSession(instance, &sci, &session) != XR_SUCCESS) return;
   XrReferenceSpaceCreateInfo rs{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};
   rs.referenceSpaceType = XR_REFERENCE_SPACE_TYPE_LOCAL;
@@ -117,7 +355,14 @@ App::App(const AppOptions& options) {
 
 App::~App() {
   destroySession();
+  destroyInstance();
+  destroyVulkan();
+}
+
+void App::destroyInstance() {
   if (instance != XR_NULL_HANDLE) xrDestroyInstance(instance);
+  instance = XR_NULL_HANDLE;
+  session = XR_NULL_HANDLE;
 }
 
 void App::destroySession() {

@@ -31,10 +31,40 @@ std::string applyEnv(const XrEnv& env);
 // Text the core validation layer logged so far (empty when it logged nothing).
 std::string validationLog();
 
-struct AppOptions {
-  std::vector<std::string> extensions;  // besides XR_MND_headless, always enabled
-  bool appActions = true;               // suggest, attach and sync an app action set
+enum class Graphics {
+  headless,  // XR_MND_headless, no graphics binding (the CPU path)
+  vulkan,    // XR_KHR_vulkan_enable: the app creates its VkInstance and VkDevice itself
+  vulkan2,   // XR_KHR_vulkan_enable2: through xrCreateVulkanInstanceKHR / xrCreateVulkanDeviceKHR
 };
+
+struct AppOptions {
+  std::vector<std::string> extensions;  // besides the graphics extension, always enabled
+  bool appActions = true;               // suggest, attach and sync an app action set
+  Graphics graphics = Graphics::headless;
+};
+
+// The app's Vulkan side (Graphics::vulkan*) on lavapipe, with the Khronos validation layer and a
+// messenger that records every warning and error.
+struct VulkanSide {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+  VkPhysicalDevice physicalDevice = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  uint32_t family = 0;
+  VkQueue queue = VK_NULL_HANDLE;
+};
+
+// A host-visible buffer of the app (the test writes meshes into it).
+struct HostBuffer {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  void* mapped = nullptr;
+};
+
+// Warning and error messages of the Vulkan validation layer so far (all apps of the process).
+std::vector<std::string> vulkanMessages();
+// Why a Vulkan app cannot run here (no loader, no device, no validation layer); empty if it can.
+std::string vulkanUnavailable();
 
 class App {
  public:
@@ -70,9 +100,19 @@ class App {
   // The app's own squeeze action state for a hand (to check the layer leaves it alone).
   float appSqueezeValue(int hand) const;
   void destroySession();
+  // Destroys the instance now (with whatever session is left), before the Vulkan device.
+  void destroyInstance();
+
+  VulkanSide vk;  // Graphics::vulkan*: the app's device
+  // A buffer on the app's device with STORAGE usage, host-visible and coherent; freed with the
+  // app (after the session).
+  HostBuffer createBuffer(VkDeviceSize bytes);
 
  private:
   void pollEvents();
+  bool setUpVulkan(Graphics graphics);
+  void destroyVulkan();
+  std::vector<HostBuffer> buffers_;
   bool ok_ = false;
   bool running_ = false;
 };

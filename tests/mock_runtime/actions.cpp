@@ -409,88 +409,75 @@ XrResult syncActions(XrSession handle, const XrActionsSyncInfo* info) {
   return focused ? XR_SUCCESS : XR_SESSION_NOT_FOCUSED;
 }
 
-XrResult getActionStateBoolean(XrSession handle, const XrActionStateGetInfo* info,
-                               XrActionStateBoolean* state) {
-  constexpr const char* cmd = "xrGetActionStateBoolean";
+// The four xrGetActionState* calls run the same checks and differ only in the action type they
+// accept and in what of the stored value they report; `report` gets the value when the action is
+// active in this slot, else null.
+template <typename State, typename Report>
+XrResult getActionState(const char* cmd, XrSession handle, const XrActionStateGetInfo* info,
+                        State* state, XrStructureType stateType, XrActionType actionType,
+                        Report report) {
   const Session* session = lookup<Session>(handle);
   if (session == nullptr) return fail(cmd, XR_ERROR_HANDLE_INVALID, "session is not valid");
   MOCK_VERIFY_TYPE(cmd, info, XR_TYPE_ACTION_STATE_GET_INFO);
-  MOCK_VERIFY_TYPE(cmd, state, XR_TYPE_ACTION_STATE_BOOLEAN);
+  if (state == nullptr) return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "(state) is null");
+  if (state->type != stateType)
+    return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "(state->type) is %d, expected %d",
+                int(state->type), int(stateType));
   const Action* action = nullptr;
   int slot = 0;
-  if (XrResult r = verifyAction(cmd, *session, info->action, info->subactionPath,
-                                XR_ACTION_TYPE_BOOLEAN_INPUT, &action, &slot);
+  if (XrResult r = verifyAction(cmd, *session, info->action, info->subactionPath, actionType,
+                                &action, &slot);
       r != XR_SUCCESS)
     return r;
   const ActionValue* v = stateOf(*session, action, slot);
-  const bool active = v != nullptr && v->active;
-  state->isActive = active;
-  state->currentState = active && v->boolean;
-  state->changedSinceLastSync = active && v->changed;
-  state->lastChangeTime = active ? v->lastChange : 0;
+  report(*state, v != nullptr && v->active ? v : nullptr);
   return XR_SUCCESS;
+}
+
+// Fills the fields every non-pose state has.
+template <typename State>
+void reportChange(State& state, const ActionValue* active) {
+  state.isActive = active != nullptr;
+  state.changedSinceLastSync = active != nullptr && active->changed;
+  state.lastChangeTime = active != nullptr ? active->lastChange : 0;
+}
+
+XrResult getActionStateBoolean(XrSession handle, const XrActionStateGetInfo* info,
+                               XrActionStateBoolean* state) {
+  return getActionState("xrGetActionStateBoolean", handle, info, state,
+                        XR_TYPE_ACTION_STATE_BOOLEAN, XR_ACTION_TYPE_BOOLEAN_INPUT,
+                        [](XrActionStateBoolean& s, const ActionValue* v) {
+                          reportChange(s, v);
+                          s.currentState = v != nullptr && v->boolean;
+                        });
 }
 
 XrResult getActionStateFloat(XrSession handle, const XrActionStateGetInfo* info,
                              XrActionStateFloat* state) {
-  constexpr const char* cmd = "xrGetActionStateFloat";
-  const Session* session = lookup<Session>(handle);
-  if (session == nullptr) return fail(cmd, XR_ERROR_HANDLE_INVALID, "session is not valid");
-  MOCK_VERIFY_TYPE(cmd, info, XR_TYPE_ACTION_STATE_GET_INFO);
-  MOCK_VERIFY_TYPE(cmd, state, XR_TYPE_ACTION_STATE_FLOAT);
-  const Action* action = nullptr;
-  int slot = 0;
-  if (XrResult r = verifyAction(cmd, *session, info->action, info->subactionPath,
-                                XR_ACTION_TYPE_FLOAT_INPUT, &action, &slot);
-      r != XR_SUCCESS)
-    return r;
-  const ActionValue* v = stateOf(*session, action, slot);
-  const bool active = v != nullptr && v->active;
-  state->isActive = active;
-  state->currentState = active ? v->value : 0.0f;
-  state->changedSinceLastSync = active && v->changed;
-  state->lastChangeTime = active ? v->lastChange : 0;
-  return XR_SUCCESS;
+  return getActionState("xrGetActionStateFloat", handle, info, state, XR_TYPE_ACTION_STATE_FLOAT,
+                        XR_ACTION_TYPE_FLOAT_INPUT,
+                        [](XrActionStateFloat& s, const ActionValue* v) {
+                          reportChange(s, v);
+                          s.currentState = v != nullptr ? v->value : 0.0f;
+                        });
 }
 
 XrResult getActionStateVector2f(XrSession handle, const XrActionStateGetInfo* info,
                                 XrActionStateVector2f* state) {
-  constexpr const char* cmd = "xrGetActionStateVector2f";
-  const Session* session = lookup<Session>(handle);
-  if (session == nullptr) return fail(cmd, XR_ERROR_HANDLE_INVALID, "session is not valid");
-  MOCK_VERIFY_TYPE(cmd, info, XR_TYPE_ACTION_STATE_GET_INFO);
-  MOCK_VERIFY_TYPE(cmd, state, XR_TYPE_ACTION_STATE_VECTOR2F);
-  const Action* action = nullptr;
-  int slot = 0;
-  if (XrResult r = verifyAction(cmd, *session, info->action, info->subactionPath,
-                                XR_ACTION_TYPE_VECTOR2F_INPUT, &action, &slot);
-      r != XR_SUCCESS)
-    return r;
-  const ActionValue* v = stateOf(*session, action, slot);
-  const bool active = v != nullptr && v->active;
-  state->isActive = active;
-  state->currentState = active ? v->vector : XrVector2f{0, 0};
-  state->changedSinceLastSync = active && v->changed;
-  state->lastChangeTime = active ? v->lastChange : 0;
-  return XR_SUCCESS;
+  return getActionState("xrGetActionStateVector2f", handle, info, state,
+                        XR_TYPE_ACTION_STATE_VECTOR2F, XR_ACTION_TYPE_VECTOR2F_INPUT,
+                        [](XrActionStateVector2f& s, const ActionValue* v) {
+                          reportChange(s, v);
+                          s.currentState = v != nullptr ? v->vector : XrVector2f{0, 0};
+                        });
 }
 
 XrResult getActionStatePose(XrSession handle, const XrActionStateGetInfo* info,
                             XrActionStatePose* state) {
-  constexpr const char* cmd = "xrGetActionStatePose";
-  const Session* session = lookup<Session>(handle);
-  if (session == nullptr) return fail(cmd, XR_ERROR_HANDLE_INVALID, "session is not valid");
-  MOCK_VERIFY_TYPE(cmd, info, XR_TYPE_ACTION_STATE_GET_INFO);
-  MOCK_VERIFY_TYPE(cmd, state, XR_TYPE_ACTION_STATE_POSE);
-  const Action* action = nullptr;
-  int slot = 0;
-  if (XrResult r = verifyAction(cmd, *session, info->action, info->subactionPath,
-                                XR_ACTION_TYPE_POSE_INPUT, &action, &slot);
-      r != XR_SUCCESS)
-    return r;
-  const ActionValue* v = stateOf(*session, action, slot);
-  state->isActive = v != nullptr && v->active;
-  return XR_SUCCESS;
+  return getActionState("xrGetActionStatePose", handle, info, state, XR_TYPE_ACTION_STATE_POSE,
+                        XR_ACTION_TYPE_POSE_INPUT, [](XrActionStatePose& s, const ActionValue* v) {
+                          s.isActive = v != nullptr;
+                        });
 }
 
 XrResult enumerateBoundSourcesForAction(XrSession handle,

@@ -1,0 +1,228 @@
+// The Vulkan path of the layer: grab-box SDFs built on the app's Vulkan device by the core's
+// VkGraspBackend. What this file translates:
+// - Vulkan entry points. Enable2 apps pass their vkGetInstanceProcAddr in
+//   xrCreateVulkanInstanceKHR / xrCreateVulkanDeviceKHR: recorded per VkInstance. Enable (v1) apps
+//   create their instance with the Vulkan loader they link; the layer takes that loader's
+//   vkGetInstanceProcAddr from the process (dlsym, or dlopen with RTLD_NOLOAD, which never loads
+//   a second copy). The layer links no Vulkan loader.
+// - Queues. The binding's queue is externally synchronized and the runtime may use it only in
+//   xrBeginFrame, xrEndFrame, xrAcquireSwapchainImage and xrReleaseSwapchainImage, where the app
+//   guarantees exclusive access: the layer submits on it only inside xrBeginFrame / xrEndFrame.
+//   For enable2 apps the layer asks one more queue of a family the app uses when the family has
+//   a spare one (xrCreateVulkanDeviceKHR); builds of CPU-array targets go there right after
+//   xrSyncActions.
+// - Failures: the backend logs one line and the session continues on the CPU.
+#include <dlfcn.h>
+
+#include <vector>
+
+#include "intercepts.h"
+#include "log.h"
+#include "state.h"
+
+#if SDFG_LAYER_VULKAN
+#include "vk_extra_queue.h"
+#include "vk_grasp_backend.h"
+#endif
+
+namespace sdfg::layer {
+namespace {
+
+std::shared_ptr<InstanceState> instanceOf(XrInstance handle) {
+  return instances().find(key(handle));
+}
+
+#if SDFG_LAYER_VULKAN
+// The app's Vulkan loader entry point for `vkInstance`.
+PFN_vkGetInstanceProcAddr appGetInstanceProcAddr(InstanceState& inst, VkInstance vkInstance) {
+  {
+    std::lock_guard lock(inst.vulkanMutex);
+    auto it = inst.vulkanGipa.find(key(vkInstance));
+    if (it != inst.vulkanGipa.end()) return it->second;
+  }
+  // Enable (v1): the loader the app linked (or dlopened globally) is in the process already.
+  if (void* f = dlsym(RTLD_DEFAULT, "vkGetInstanceProcAddr"))
+    return reinterpret_cast<PFN_vkGetInstanceProcAddr>(f);
+  // Loaded with RTLD_LOCAL: find it by name without loading a new copy.
+  if (void* lib = dlopen("libvulkan.so.1", RTLD_NOW | RTLD_NOLOAD)) {
+    auto f = reinterpret_cast<PFN_vkGetInstanceProcAddr>(dlsym(lib, "vkGetInstanceProcAddr"));
+    dlclose(lib);  // drops only the reference RTLD_NOLOAD took; the app's stays
+    return f;
+  }
+  return nullptr;
+}
+
+VkGraspFault faultFromConfig(const std::string& name) {
+  if (name == "lost_at_submit") return VkGraspFault::lostAtSubmit;
+  if (name == "lost_at_poll") return VkGraspFault::lostAtPoll;
+  return VkGraspFault::none;
+}
+#endif
+
+}  // namespace
+
+std::unique_ptr<DeferredSdfBackend> makeVulkanBackend(SessionState& s) {
+  constexpr const char* cmd = "xrCreateSession";
+  s.vulkanBackend = nullptr;
+  s.ownQueue = false;
+  if (!s.vulkan) return nullptr;
+#if SDFG_LAYER_VULKAN
+  InstanceState& inst = *s.instance;
+  if (!inst.config.gpu) {
+    SDFG_LOG_INFO(cmd, "gpu = false: grab-box SDFs on the CPU");
+    return nullptr;
+  }
+  const XrGraphicsBindingVulkanKHR& b = s.vulkanBinding;
+  VulkanDevice app;
+  app.instance = b.instance;
+  app.physicalDevice = b.physicalDevice;
+  app.device = b.device;
+  app.queueFamilyIndex = b.queueFamilyIndex;
+  app.queueIndex = b.queueIndex;
+  app.getInstanceProcAddr = appGetInstanceProcAddr(inst, b.instance);
+  if (app.getInstanceProcAddr == nullptr) {
+    SDFG_LOG_WARN(cmd, "no Vulkan loader in the process: grab-box SDFs on the CPU");
+    return nullptr;
+  }
+  std::optional<VulkanDevice> own;
+  {
+    std::lock_guard lock(inst.vulkanMutex);
+    auto it = inst.extraQueues.find(key(b.device));
+    if (it != inst.extraQueues.end()) {
+      own = app;
+      own->queueFamilyIndex = it->second.family;
+      own->queueIndex = it->second.index;
+    }
+  }
+  VkGraspBackendOptions options;
+  options.log = [](const std::string& line) { SDFG_LOG_WARN("sdfg vulkan", "%s", line.c_str()); };
+  auto backend = VkGraspBackend::create(app, own ? &*own : nullptr, options);
+  if (!backend) {
+    SDFG_LOG_WARN(cmd, "Vulkan SDF backend unavailable, grab-box SDFs on the CPU: %s",
+                  backend.error().message.c_str());
+    return nullptr;
+  }
+  (*backend)->injectFault(faultFromConfig(inst.config.testGpuFault));
+  s.vulkanBackend = backend->get();
+  s.ownQueue = own.has_value();
+  SDFG_LOG_INFO(cmd, "grab-box SDFs on the app's Vulkan device (%s)",
+                s.ownQueue ? "the layer's own queue" : "the app's queue inside frame calls");
+  return std::move(backend.value());
+#else
+  SDFG_LOG_INFO(cmd, "built without the Vulkan backend: grab-box SDFs on the CPU");
+  return nullptr;
+#endif
+}
+
+void submitGpuWork(SessionState& s, bool inFrame, const char* cmd) {
+  if (s.vulkanBackend == nullptr || s.grasp == nullptr || !s.grasp->needsSubmit(inFrame)) return;
+  if (s.grasp->submitDeferred(inFrame) != Status::ok)
+    SDFG_LOG_WARN(cmd, "GPU submission failed; this session builds on the CPU from now on");
+}
+
+void dropGpuWork(SessionState& s) {
+  s.vulkanBackend = nullptr;
+  s.ownQueue = false;
+  if (s.grasp != nullptr) s.grasp->dropDeferred();
+}
+
+XrResult XRAPI_CALL SdfgXrBeginFrame(XrSession session, const XrFrameBeginInfo* info) {
+  constexpr const char* cmd = "xrBeginFrame";
+  SDFG_ENTRY_BEGIN
+  auto s = sessions().find(key(session));
+  if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
+  if (s->vulkan) {
+    // The app holds the queue for the runtime during this call: ours to use before calling down.
+    std::lock_guard lock(s->mutex);
+    submitGpuWork(*s, true, cmd);
+  }
+  return s->instance->next.xrBeginFrame(session, info);
+  SDFG_ENTRY_END(cmd)
+}
+
+XrResult XRAPI_CALL SdfgXrEndFrame(XrSession session, const XrFrameEndInfo* info) {
+  constexpr const char* cmd = "xrEndFrame";
+  SDFG_ENTRY_BEGIN
+  auto s = sessions().find(key(session));
+  if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
+  if (s->vulkan) {
+    std::lock_guard lock(s->mutex);
+    submitGpuWork(*s, true, cmd);
+  }
+  return s->instance->next.xrEndFrame(session, info);
+  SDFG_ENTRY_END(cmd)
+}
+
+XrResult XRAPI_CALL SdfgXrCreateVulkanInstanceKHR(XrInstance instance,
+                                                  const XrVulkanInstanceCreateInfoKHR* info,
+                                                  VkInstance* vulkanInstance,
+                                                  VkResult* vulkanResult) {
+  constexpr const char* cmd = "xrCreateVulkanInstanceKHR";
+  SDFG_ENTRY_BEGIN
+  auto state = instanceOf(instance);
+  if (state == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(instance) is not valid");
+  const XrResult r =
+      state->next.xrCreateVulkanInstanceKHR(instance, info, vulkanInstance, vulkanResult);
+  if (XR_SUCCEEDED(r) && info != nullptr && vulkanInstance != nullptr &&
+      *vulkanInstance != VK_NULL_HANDLE && info->pfnGetInstanceProcAddr != nullptr) {
+    std::lock_guard lock(state->vulkanMutex);
+    state->vulkanGipa[key(*vulkanInstance)] = info->pfnGetInstanceProcAddr;
+    state->lastVulkanInstance = *vulkanInstance;
+  }
+  return r;
+  SDFG_ENTRY_END(cmd)
+}
+
+XrResult XRAPI_CALL SdfgXrCreateVulkanDeviceKHR(XrInstance instance,
+                                                const XrVulkanDeviceCreateInfoKHR* info,
+                                                VkDevice* device, VkResult* vulkanResult) {
+  constexpr const char* cmd = "xrCreateVulkanDeviceKHR";
+  SDFG_ENTRY_BEGIN
+  auto state = instanceOf(instance);
+  if (state == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(instance) is not valid");
+  auto& next = state->next.xrCreateVulkanDeviceKHR;
+#if SDFG_LAYER_VULKAN
+  VkInstance vkInstance = VK_NULL_HANDLE;
+  {
+    std::lock_guard lock(state->vulkanMutex);
+    vkInstance = state->lastVulkanInstance;
+  }
+  if (state->config.gpu && state->config.extraQueue && info != nullptr &&
+      info->type == XR_TYPE_VULKAN_DEVICE_CREATE_INFO_KHR && info->vulkanCreateInfo != nullptr &&
+      info->pfnGetInstanceProcAddr != nullptr && info->vulkanPhysicalDevice != VK_NULL_HANDLE &&
+      vkInstance != VK_NULL_HANDLE && device != nullptr && vulkanResult != nullptr) {
+    auto families = reinterpret_cast<PFN_vkGetPhysicalDeviceQueueFamilyProperties>(
+        info->pfnGetInstanceProcAddr(vkInstance, "vkGetPhysicalDeviceQueueFamilyProperties"));
+    std::vector<VkQueueFamilyProperties> props;
+    if (families != nullptr) {
+      uint32_t n = 0;
+      families(info->vulkanPhysicalDevice, &n, nullptr);
+      props.resize(n);
+      families(info->vulkanPhysicalDevice, &n, props.data());
+    }
+    const ExtraQueuePlan plan = planExtraQueue(*info->vulkanCreateInfo, props);
+    if (plan.planned) {
+      VkDeviceCreateInfo dci = *info->vulkanCreateInfo;
+      dci.queueCreateInfoCount = uint32_t(plan.queueInfos.size());
+      dci.pQueueCreateInfos = plan.queueInfos.data();
+      XrVulkanDeviceCreateInfoKHR copy = *info;
+      copy.vulkanCreateInfo = &dci;
+      const XrResult r = next(instance, &copy, device, vulkanResult);
+      if (XR_SUCCEEDED(r) && *vulkanResult == VK_SUCCESS) {
+        std::lock_guard lock(state->vulkanMutex);
+        state->extraQueues[key(*device)] = {plan.family, plan.index};
+        SDFG_LOG_INFO(cmd, "added queue %u of family %u for the layer", plan.index, plan.family);
+        return r;
+      }
+      SDFG_LOG_WARN(cmd,
+                    "the device refused the layer's extra queue (%d, %d); creating it as "
+                    "the app asked",
+                    int(r), int(*vulkanResult));
+    }
+  }
+#endif
+  return next(instance, info, device, vulkanResult);
+  SDFG_ENTRY_END(cmd)
+}
+
+}  // namespace sdfg::layer

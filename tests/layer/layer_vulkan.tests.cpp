@@ -1,0 +1,325 @@
+// The layer's Vulkan path end to end: sessions created with XR_KHR_vulkan_enable and
+// XR_KHR_vulkan_enable2 on lavapipe, the app's instance with the Khronos Vulkan validation
+// layer (any warning or error fails the test, including objects the layer leaves on the app's
+// device, reported at vkDestroyDevice) and the OpenXR core validation layer below the layer.
+// That the SDF came from the GPU is read from the extension's XrGraspBuildInfoSDFG, not assumed.
+#include <catch2/catch.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <thread>
+
+#include "grasp_checks.h"
+#include "test_scenes.h"
+#include "xr_harness.h"
+
+namespace {
+
+using namespace sdfg::test;
+
+const char* graphicsName(Graphics g) {
+  return g == Graphics::vulkan ? "XR_KHR_vulkan_enable" : "XR_KHR_vulkan_enable2";
+}
+
+// A right hand at `grip` that squeezes fully from frame 3.
+XrEnv squeezeEnv(const XrPosef& grip) {
+  XrEnv env;
+  env.handTracking = "absent";
+  env.script = gripLine(0, "right", grip) + squeezeLine(0, "right", 0.0f) +
+               squeezeLine(2, "right", 0.0f) + squeezeLine(3, "right", 1.0f);
+  return env;
+}
+
+struct State {
+  XrGraspStateSDFG state{XR_TYPE_GRASP_STATE_SDFG};
+  XrGraspBuildInfoSDFG build{XR_TYPE_GRASP_BUILD_INFO_SDFG};
+};
+
+State graspState(const App& app, const Ext& ext) {
+  State s;
+  s.state.next = &s.build;
+  XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
+  REQUIRE(ext.state(app.session, &gi, &s.state) == XR_SUCCESS);
+  return s;
+}
+
+// Runs frames until the hand shows a grasp (the GPU result arrives a frame or more after the
+// request), at most `maxFrames`. The sleep lets lavapipe's worker run; it is the test's, not the
+// layer's (the layer never waits in the frame path).
+State runUntilGrasping(App& app, const Ext& ext, int maxFrames = 400) {
+  State s = graspState(app, ext);
+  for (int i = 0; i < maxFrames && !s.state.isGrasping; ++i) {
+    app.frame();
+    s = graspState(app, ext);
+    if (!s.state.isGrasping) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return s;
+}
+
+GraspOutcome outcome(const App& app, XrHandTrackerEXT tracker, const State& s) {
+  GraspOutcome out;
+  REQUIRE(locateJoints(app, tracker, out.joints) == XR_SUCCESS);
+  out.state = s.state;
+  return out;
+}
+
+// The mesh in a vertex buffer of stride 24 starting 16 bytes in, every non-position float NaN
+// (a reader that ignores the stride or offset meets NaN corners and skips those triangles), and
+// 16-bit indices 6 bytes into their buffer.
+struct BufferMesh {
+  HostBuffer vertices, indices;
+  XrGraspTargetVulkanBuffersSDFG desc{XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG};
+};
+
+void writeVertices(const BufferMesh& m, const TestMesh& mesh, float scale) {
+  auto* v = static_cast<float*>(m.vertices.mapped);
+  for (size_t i = 0; i < m.desc.vertexOffset / 4 + mesh.vertices.size() * 6; ++i)
+    v[i] = std::nanf("");
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    float* p = v + m.desc.vertexOffset / 4 + i * (m.desc.vertexStride / 4);
+    p[0] = mesh.vertices[i].x * scale;
+    p[1] = mesh.vertices[i].y * scale;
+    p[2] = mesh.vertices[i].z * scale;
+  }
+}
+
+BufferMesh uploadMesh(App& app, const TestMesh& mesh, float scale) {
+  REQUIRE(mesh.vertices.size() < 65536);
+  BufferMesh m;
+  m.desc.vertexOffset = 16;
+  m.desc.vertexStride = 24;
+  m.desc.vertexCount = uint32_t(mesh.vertices.size());
+  m.desc.indexOffset = 6;
+  m.desc.indexType = VK_INDEX_TYPE_UINT16;
+  m.desc.indexCount = uint32_t(mesh.indices.size());
+  m.vertices = app.createBuffer(16 + mesh.vertices.size() * 24);
+  m.indices = app.createBuffer(6 + mesh.indices.size() * 2);
+  REQUIRE(m.vertices.mapped != nullptr);
+  REQUIRE(m.indices.mapped != nullptr);
+  m.desc.vertexBuffer = m.vertices.buffer;
+  m.desc.indexBuffer = m.indices.buffer;
+  writeVertices(m, mesh, scale);
+  auto* idx = reinterpret_cast<uint16_t*>(static_cast<char*>(m.indices.mapped) + 6);
+  for (size_t i = 0; i < mesh.indices.size(); ++i) idx[i] = uint16_t(mesh.indices[i]);
+  XrVector3f lo{1e9f, 1e9f, 1e9f}, hi{-1e9f, -1e9f, -1e9f};
+  for (const XrVector3f& p : mesh.vertices) {
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+  m.desc.boundsMin = lo;
+  m.desc.boundsMax = hi;
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("On a Vulkan session the grab-box SDF is built on the GPU and fingers touch a sphere",
+          "[layer][vulkan]") {
+  if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  for (Graphics graphics : {Graphics::vulkan, Graphics::vulkan2}) {
+    CAPTURE(graphicsName(graphics));
+    const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+    const XrVector3f centre = boxCentreInLocal(grip, /*right=*/true);
+    const float radius = 0.04f;
+    applyEnv(squeezeEnv(grip));
+    const size_t messagesBefore = vulkanMessages().size();
+    {
+      App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME},
+               true,
+               graphics});
+      REQUIRE(app.ok());
+      Ext ext(app);
+      XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
+      makeTarget(app, ext, makeIcosphere(radius, 4), {{0, 0, 0, 1}, centre});
+      State s = graspState(app, ext);
+      CHECK(s.build.sessionBackend == XR_GRASP_SDF_BACKEND_VULKAN_SDFG);
+      s = runUntilGrasping(app, ext);
+      REQUIRE(s.state.isGrasping);
+      CHECK(s.build.graspBackend == XR_GRASP_SDF_BACKEND_VULKAN_SDFG);
+      CHECK(s.build.gpuBuildCount >= 1);
+      CHECK(s.build.cpuBuildCount == 0);
+      CHECK_FALSE(s.build.gpuFailed);
+      checkContacts(outcome(app, tracker, s),
+                    [&](const XrVector3f& p) { return length(sub(p, centre)) - radius; });
+    }
+    CHECK(validationLog().empty());
+    const std::vector<std::string> messages = vulkanMessages();
+    CHECK(messages.size() == messagesBefore);
+  }
+}
+
+TEST_CASE("A target in the app's Vulkan buffers (strided, 16-bit indices) is grasped and updated",
+          "[layer][vulkan]") {
+  if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+  const XrVector3f centre = boxCentreInLocal(grip, /*right=*/true);
+  const float radius = 0.04f;
+  const TestMesh sphere = makeIcosphere(radius, 3);
+  applyEnv(squeezeEnv(grip));
+  const size_t messagesBefore = vulkanMessages().size();
+  {
+    App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME},
+             true,
+             Graphics::vulkan2});
+    REQUIRE(app.ok());
+    Ext ext(app);
+    auto update = app.fn<PFN_xrUpdateGraspTargetVerticesSDFG>("xrUpdateGraspTargetVerticesSDFG");
+    XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
+    BufferMesh m = uploadMesh(app, sphere, 1.0f);
+    XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &m.desc};
+    ci.placement = {
+        XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, app.local, {{0, 0, 0, 1}, centre}};
+
+    SECTION("bad descriptions are refused") {
+      XrGraspTargetSDFG t = XR_NULL_HANDLE;
+      XrGraspTargetVulkanBuffersSDFG bad = m.desc;
+      bad.vertexStride = 14;
+      ci.next = &bad;
+      CHECK(ext.create(app.session, &ci, &t) == XR_ERROR_VALIDATION_FAILURE);
+      bad = m.desc;
+      bad.indexType = VK_INDEX_TYPE_UINT8_EXT;
+      CHECK(ext.create(app.session, &ci, &t) == XR_ERROR_VALIDATION_FAILURE);
+      bad = m.desc;
+      bad.indexOffset = 5;
+      CHECK(ext.create(app.session, &ci, &t) == XR_ERROR_VALIDATION_FAILURE);
+      bad = m.desc;
+      bad.boundsMax.x = std::nanf("");
+      CHECK(ext.create(app.session, &ci, &t) == XR_ERROR_VALIDATION_FAILURE);
+      CHECK(t == XR_NULL_HANDLE);
+      // The kinds do not mix on update.
+      ci.next = &m.desc;
+      REQUIRE(ext.create(app.session, &ci, &t) == XR_SUCCESS);
+      XrGraspTargetVerticesSDFG arrays{XR_TYPE_GRASP_TARGET_VERTICES_SDFG};
+      arrays.vertexCount = uint32_t(sphere.vertices.size());
+      arrays.vertices = sphere.vertices.data();
+      CHECK(update(t, &arrays) == XR_ERROR_VALIDATION_FAILURE);
+      XrGraspTargetVulkanBuffersSDFG fewer = m.desc;
+      fewer.vertexCount -= 1;
+      CHECK(update(t, &fewer) == XR_ERROR_VALIDATION_FAILURE);
+      XrGraspTargetSDFG cpu = makeTarget(app, ext, sphere, {{0, 0, 0, 1}, {0, 0, -3}});
+      CHECK(update(cpu, &m.desc) == XR_ERROR_VALIDATION_FAILURE);
+    }
+
+    SECTION("grasped from the buffers, and again after the app rewrites them") {
+      XrGraspTargetSDFG t = XR_NULL_HANDLE;
+      REQUIRE(ext.create(app.session, &ci, &t) == XR_SUCCESS);
+      State s = runUntilGrasping(app, ext);
+      REQUIRE(s.state.isGrasping);
+      CHECK(s.state.target == t);
+      CHECK(s.build.graspBackend == XR_GRASP_SDF_BACKEND_VULKAN_SDFG);
+      checkContacts(outcome(app, tracker, s),
+                    [&](const XrVector3f& p) { return length(sub(p, centre)) - radius; });
+      float curlBefore = 0.0f;
+      for (const auto& f : s.state.fingers) curlBefore += f.curl;
+
+      // A skinned mesh's new pose: the sphere shrinks in place; nothing of the GPU reads it now
+      // (the hand holds still, so no build is running).
+      REQUIRE(s.build.pendingGpuBuilds == 0);
+      const uint64_t builds = s.build.gpuBuildCount;
+      writeVertices(m, sphere, 0.85f);
+      REQUIRE(update(t, &m.desc) == XR_SUCCESS);
+      for (int i = 0; i < 400 && s.build.gpuBuildCount == builds; ++i) {
+        app.frame();
+        s = graspState(app, ext);
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
+      REQUIRE(s.build.gpuBuildCount > builds);
+      REQUIRE(s.state.isGrasping);
+      float curlAfter = 0.0f;
+      for (const auto& f : s.state.fingers) curlAfter += f.curl;
+      CHECK(curlAfter > curlBefore + 0.05f);  // the fingers followed the smaller surface
+      checkContacts(outcome(app, tracker, s),
+                    [&](const XrVector3f& p) { return length(sub(p, centre)) - radius * 0.85f; });
+      REQUIRE(ext.destroy(t) == XR_SUCCESS);
+    }
+  }
+  CHECK(validationLog().empty());
+  CHECK(vulkanMessages().size() == messagesBefore);
+}
+
+TEST_CASE(
+    "Destroying the session or the instance with a GPU build in flight neither hangs nor "
+    "leaks",
+    "[layer][vulkan]") {
+  if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+  const XrVector3f centre = boxCentreInLocal(grip, /*right=*/true);
+  for (bool wholeInstance : {false, true}) {
+    CAPTURE(wholeInstance);
+    applyEnv(squeezeEnv(grip));
+    const size_t messagesBefore = vulkanMessages().size();
+    {
+      App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME},
+               true,
+               Graphics::vulkan2});
+      REQUIRE(app.ok());
+      Ext ext(app);
+      makeTracker(app, ext, XR_HAND_RIGHT_EXT);
+      // A 32^3 grid on a 5k-triangle sphere: the build runs for milliseconds on lavapipe (a
+      // much bigger one can outlast the layer's 2 s bound on a loaded machine, and the layer
+      // then leaks rather than free objects the GPU may still use).
+      auto setOptions = app.fn<PFN_xrSetGraspOptionsSDFG>("xrSetGraspOptionsSDFG");
+      XrGraspOptionsSDFG o{XR_TYPE_GRASP_OPTIONS_SDFG};
+      o.resolution = 32;
+      REQUIRE(setOptions(app.session, &o) == XR_SUCCESS);
+      makeTarget(app, ext, makeIcosphere(0.04f, 4), {{0, 0, 0, 1}, centre});
+      State s = graspState(app, ext);
+      for (int i = 0; i < 20 && s.build.pendingGpuBuilds == 0; ++i) {
+        app.frame();  // the frame's xrEndFrame submits what its xrSyncActions requested
+        s = graspState(app, ext);
+      }
+      REQUIRE(s.build.pendingGpuBuilds == 1);
+      CHECK_FALSE(s.state.isGrasping);
+      const auto start = std::chrono::steady_clock::now();
+      if (wholeInstance) {
+        app.destroyInstance();
+      } else {
+        app.destroySession();
+      }
+      CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(3));
+    }  // the app destroys its device: the validation layer reports any object left on it
+    CHECK(validationLog().empty());
+    CHECK(vulkanMessages().size() == messagesBefore);
+  }
+}
+
+TEST_CASE("A device loss on the GPU path falls back to the CPU and the hand still grasps",
+          "[layer][vulkan]") {
+  if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+  const XrVector3f centre = boxCentreInLocal(grip, /*right=*/true);
+  const float radius = 0.04f;
+  // Injected through the layer's test-only key test_gpu_fault (docs/layer.md): a simulated
+  // VK_ERROR_DEVICE_LOST from vkQueueSubmit, or from the fence poll while the real work runs.
+  for (const char* fault : {"lost_at_submit", "lost_at_poll"}) {
+    CAPTURE(fault);
+    XrEnv env = squeezeEnv(grip);
+    env.extra = {{"SDFG_AUTOGRASP_TEST_GPU_FAULT", fault}};
+    applyEnv(env);
+    const size_t messagesBefore = vulkanMessages().size();
+    {
+      App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME},
+               true,
+               Graphics::vulkan2});
+      REQUIRE(app.ok());
+      Ext ext(app);
+      XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
+      makeTarget(app, ext, makeIcosphere(radius, 4), {{0, 0, 0, 1}, centre});
+      State s = runUntilGrasping(app, ext, 50);
+      REQUIRE(s.state.isGrasping);
+      CHECK(s.build.gpuFailed);
+      CHECK(s.build.graspBackend == XR_GRASP_SDF_BACKEND_CPU_SDFG);
+      CHECK(s.build.sessionBackend == XR_GRASP_SDF_BACKEND_CPU_SDFG);
+      CHECK(s.build.gpuBuildCount == 0);
+      CHECK(s.build.cpuBuildCount >= 1);
+      checkContacts(outcome(app, tracker, s),
+                    [&](const XrVector3f& p) { return length(sub(p, centre)) - radius; });
+      // Later frames keep working on the CPU.
+      app.frames(3);
+      CHECK(graspState(app, ext).state.isGrasping);
+    }
+    CHECK(validationLog().empty());
+    CHECK(vulkanMessages().size() == messagesBefore);
+  }
+}

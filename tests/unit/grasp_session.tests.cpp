@@ -1,0 +1,168 @@
+// GraspSession with a deferred SDF backend (the layer's Vulkan path, here a CPU stand-in that
+// counts its calls): builds are requested in update(), run only at submitDeferred(), collected
+// by a later update(); a device failure redoes the build on the CPU in the same update.
+#include <catch2/catch.hpp>
+
+#include "grasp_session.h"
+#include "sdf_cpu.h"
+#include "shapes.h"
+
+namespace {
+
+using namespace sdfg;
+
+class FakeDeferred final : public DeferredSdfBackend {
+ public:
+  std::string_view name() const override { return "fake"; }
+  Status request(size_t slot, uint64_t, uint64_t, const TriangleMesh* mesh, const Pose& pose,
+                 const GridBox& box) override {
+    if (failed_) return Status::device_lost;
+    if (slot >= kSlots || mesh == nullptr) return Status::invalid_argument;
+    Slot& s = slots_[slot];
+    if (s.recorded || s.submitted) return Status::unsupported;
+    auto distance = MeshDistance::create(*mesh);
+    if (!distance) return Status::invalid_argument;
+    s.distance = std::move(distance.value());
+    s.pose = pose;
+    s.box = box;
+    s.recorded = true;
+    ++requests;
+    return Status::ok;
+  }
+  bool hasDeviceMesh(uint64_t) const override { return false; }
+  bool needsSubmit(bool) const override {
+    return !failed_ && (slots_[0].recorded || slots_[1].recorded);
+  }
+  Status submit(bool) override {
+    for (Slot& s : slots_) {
+      if (!s.recorded) continue;
+      s.recorded = false;
+      s.submitted = true;
+      ++submits;
+    }
+    return Status::ok;
+  }
+  BuildPoll poll(size_t slot, SdfGrid& out) override {
+    if (failed_) return BuildPoll::failed;
+    Slot& s = slots_[slot];
+    if (s.recorded) return BuildPoll::pending;
+    if (!s.submitted) return BuildPoll::idle;
+    if (busy) return BuildPoll::pending;
+    if (failAtPoll) {
+      failed_ = true;
+      return BuildPoll::failed;
+    }
+    s.submitted = false;
+    if (s.discard) {
+      s.discard = false;
+      return BuildPoll::idle;
+    }
+    REQUIRE(cpu.build(*s.distance, s.pose, s.box, out) == Status::ok);
+    return BuildPoll::ready;
+  }
+  void cancel(size_t slot) override {
+    slots_[slot].recorded = false;
+    if (slots_[slot].submitted) slots_[slot].discard = true;
+    ++cancels;
+  }
+  bool failed() const override { return failed_; }
+
+  bool failAtPoll = false;
+  bool busy = false;  // the device has not finished yet
+  int requests = 0, submits = 0, cancels = 0;
+
+ private:
+  struct Slot {
+    std::unique_ptr<MeshDistance> distance;
+    Pose pose;
+    GridBox box;
+    bool recorded = false, submitted = false, discard = false;
+  };
+  std::array<Slot, kSlots> slots_;
+  CpuSdfBuilder cpu{1};
+  bool failed_ = false;
+};
+
+// A right hand whose grab box is centred on a 4 cm sphere at the origin, squeezing.
+HandFrame squeezing(float squeeze) {
+  HandFrame f;
+  f.valid = true;
+  f.squeeze = squeeze;
+  f.worldFromWrist = GridBox::referenceDefault().handFromBox.inverse();
+  return f;
+}
+
+}  // namespace
+
+TEST_CASE("GraspSession with a deferred backend solves only after the owner submits",
+          "[grasp_session][deferred]") {
+  auto owned = std::make_unique<FakeDeferred>();
+  FakeDeferred& gpu = *owned;
+  GraspSession session(makeCpuSdfBackend(1), std::move(owned));
+  REQUIRE(session.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
+  const TargetFrame target{7, true, Pose{}};
+
+  REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+  CHECK(session.grasp(Hand::right).holding);
+  CHECK(session.grasp(Hand::right).solves == 0);
+  CHECK(gpu.requests == 1);
+  CHECK(session.pendingBuilds() == 1);
+  CHECK(session.needsSubmit(true));
+
+  SECTION("nothing is built until submitDeferred") {
+    REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    CHECK(session.grasp(Hand::right).solves == 0);
+    CHECK(gpu.requests == 1);  // one request at a time
+    CHECK(gpu.submits == 0);
+  }
+  SECTION("the result is collected and solved at the next update") {
+    REQUIRE(session.submitDeferred(true) == Status::ok);
+    CHECK(gpu.submits == 1);
+    REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    const HandGrasp& g = session.grasp(Hand::right);
+    CHECK(g.solves == 1);
+    CHECK(g.builtOnGpu);
+    CHECK(session.buildStats().gpuBuilds == 1);
+    CHECK(session.buildStats().cpuBuilds == 0);
+    int contacts = 0;
+    for (const FingerState& f : g.result.fingers) contacts += f.contact ? 1 : 0;
+    CHECK(contacts >= 3);
+    // Nothing moved: no new request.
+    REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    CHECK(gpu.requests == 1);
+  }
+  SECTION("a device failure at the poll redoes the build on the CPU in the same update") {
+    REQUIRE(session.submitDeferred(true) == Status::ok);
+    gpu.failAtPoll = true;
+    REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    const HandGrasp& g = session.grasp(Hand::right);
+    CHECK(g.solves == 1);
+    CHECK_FALSE(g.builtOnGpu);
+    CHECK(session.buildStats().gpuFailed);
+    CHECK(session.buildStats().cpuBuilds == 1);
+    CHECK_FALSE(session.deferredUsable());
+    // Later builds go to the CPU at once.
+    session.release(Hand::right);
+    REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    CHECK(session.grasp(Hand::right).solves == 1);
+    CHECK(session.buildStats().cpuBuilds == 2);
+  }
+  SECTION("releasing the squeeze cancels the build in flight") {
+    REQUIRE(session.submitDeferred(true) == Status::ok);
+    gpu.busy = true;
+    REQUIRE(session.update(Hand::right, squeezing(0.0f), {&target, 1}) == Status::ok);
+    CHECK_FALSE(session.grasp(Hand::right).holding);
+    CHECK(gpu.cancels == 1);
+    CHECK(session.pendingBuilds() == 0);
+    // Its result, when the device finishes, is dropped; a new grab asks again.
+    gpu.busy = false;
+    REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    CHECK(session.grasp(Hand::right).solves == 0);
+    CHECK(session.buildStats().gpuBuilds == 0);
+  }
+  SECTION("a device target needs a backend that holds its mesh") {
+    CHECK(session.addDeviceTarget(9, Aabb{glm::vec3(-0.1f), glm::vec3(0.1f)}) ==
+          Status::unsupported);
+    CHECK_FALSE(session.hasTarget(9));
+  }
+}

@@ -538,8 +538,10 @@ TEST_CASE("ours with an exact source: contacts end within 0.1 mm of touching, no
         const FingerState& st = s.result.fingers[f];
         const float clearance = exactCapsuleClearance(shape.fn, hand, Finger(f), st.jointCurls);
         CAPTURE(fingerName(Finger(f)), st.curl, st.contact, clearance);
-        // Nothing inside: not the dense capsule (the evaluator's model) beyond 0.1 mm.
+        // Nothing inside: not the dense capsule (the evaluator's model) beyond 0.1 mm, nor on
+        // the way there (the check's closing moves are bounded, so it cannot tunnel either).
         CHECK(clearance >= -1e-4f);
+        CHECK_FALSE(sweptThrough(shape.fn, hand, Finger(f), st.curl));
         if (st.contact) {
           ++contacts;
           // The touching sphere is within 0.1 mm of the surface, by the exact distance...

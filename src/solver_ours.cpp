@@ -35,8 +35,8 @@ constexpr float kMaxPolishOpen = 0.012f;           // and opening, which is alwa
 constexpr float kMaxTrilinearOvershoot = 0.0015f;  // metres
 constexpr int kMaxPolishIterations = 8;
 constexpr int kMaxRefineIterations = 40;
-// Exact check (exactStop()): secant steps on the exact clearance, each closing move limited to
-// kExactBand of motion of the fastest sphere checked (beyond the band the field is trusted).
+// Exact check (exactStop()): at most this many secant steps on the exact clearance, and this
+// many doubling opening steps when every pose tried was inside.
 constexpr int kMaxExactIterations = 8;
 constexpr int kMaxExactBackoff = 6;
 // Kinematics rebuilt from fingerPose() must match it this closely, else solve() asks the model.
@@ -627,10 +627,13 @@ struct ExactEval {
 // against its own bone's capsule: the exact closest point q of its centre, its distance to the
 // bone's axis minus the capsule radius there (at most the centre's distance minus its radius;
 // it sees a bone that leans into the surface next to the centre). Secant steps on the smallest
-// clearance bring it into [0, kContactTolerance]; a closing move is limited to kExactBand of
-// motion, opening never goes below aStart (where the group began). The most closed pose with no
-// checked sphere inside is kept; if none was found, the group opens in doubling steps until one
-// is. Reports the closest sphere as the touching one when it is within the tolerance.
+// clearance bring it into [0, kContactTolerance]. Closing past the field's stop is limited so
+// that no sphere left unchecked (distal ones included) moves more than its clearance on the
+// field; opening may go below where the group began (down to 0), which is how a sphere the
+// previous group left inside comes out. Spheres are re-chosen at every pose tried. The most
+// closed pose with no checked sphere inside is kept; if none was found, the group opens in
+// doubling steps while that helps and the least inside pose is kept. Reports the closest sphere
+// as the touching one when it is within the tolerance (or when the field said it touched).
 float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int lastBone, float a,
                             JointCurls& curls, int& touching, glm::vec3& touchPoint,
                             float& touchValue, int& samples) const {

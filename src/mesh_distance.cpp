@@ -443,6 +443,36 @@ Status MeshDistance::signedDistances(std::span<const glm::vec3> points,
   return Status::ok;
 }
 
+float MeshDistance::localSignedDistanceWithin(const glm::vec3& p, float maxDistance,
+                                              glm::vec3* closestPoint) const {
+  const Impl& m = *impl_;
+  if (!(maxDistance >= 0.0f)) return std::numeric_limits<float>::infinity();
+  TriangleBvh::Hit seed;
+  seed.distanceSquared = double(maxDistance) * double(maxDistance);
+  const TriangleBvh::Hit hit = m.bvh.closest(p, seed);
+  if (!hit.found()) return std::numeric_limits<float>::infinity();
+  if (closestPoint != nullptr) *closestPoint = glm::vec3(hit.point);
+  const uint32_t* tri = &m.mesh.indices[3 * hit.triangle];
+  glm::dvec3 n(0.0);
+  switch (hit.feature) {
+    case TriangleFeature::face:
+      n = m.faceNormal[hit.triangle];
+      break;
+    case TriangleFeature::edge0:
+    case TriangleFeature::edge1:
+    case TriangleFeature::edge2:
+      n = m.edgeNormal[m.triangleEdge[3 * hit.triangle + (int(hit.feature) - 1)]];
+      break;
+    case TriangleFeature::vertex0:
+    case TriangleFeature::vertex1:
+    case TriangleFeature::vertex2:
+      n = m.vertexNormal[tri[int(hit.feature) - 4]];
+      break;
+  }
+  const float d = float(std::sqrt(hit.distanceSquared));
+  return glm::dot(glm::dvec3(p) - hit.point, n) < 0.0 ? -d : d;
+}
+
 float MeshDistance::windingNumber(const glm::vec3& p) const {
   impl_->ensureClusters();
   return float(impl_->winding(p));

@@ -45,6 +45,15 @@ class MeshDistance {
   // Skips subtrees farther than `maxDistance`; returns infinity when nothing is that close.
   ClosestPoint closestWithin(const glm::vec3& p, float maxDistance) const;
   float signedDistance(const glm::vec3& p) const;
+  // closestWithin() with a local sign, for checks near the surface that must stay cheap: the
+  // sign is the side of the closest feature's angle-weighted pseudo-normal, on every mesh. On
+  // closed meshes that is signedDistance()'s sign; on open ones (where signedDistance() pays for
+  // a winding number) it is the side of the nearest sheet, which differs only near holes and
+  // where open parts overlap. Returns +infinity when no triangle is within `maxDistance` (the
+  // sign is then unknown); writes the closest point to *closestPoint when one was found and the
+  // pointer is not null.
+  float localSignedDistanceWithin(const glm::vec3& p, float maxDistance,
+                                  glm::vec3* closestPoint = nullptr) const;
   // signedDistance(p) seeded with a triangle likely to be near `p` (in a sweep over grid nodes,
   // the previous node's closest triangle): its exact distance bounds the search, so far less of
   // the hierarchy is visited. Same distance as signedDistance(p) whatever the hint (the sign too,

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "mesh_distance.h"
 #include "solver_ours.h"
 #include "solver_paper.h"
 #include "solver_physics.h"
@@ -77,6 +78,23 @@ Result<std::unique_ptr<GraspSolver>> createSolver(std::string_view name) {
   }
   return makeError(Status::invalid_argument,
                    "solver: unknown strategy \"" + std::string(name) + "\"; known: " + known);
+}
+
+MeshExactSource::MeshExactSource(const MeshDistance& mesh, const Pose& objectFromHand)
+    : mesh_(&mesh), objectFromHand_(objectFromHand), handFromObject_(objectFromHand.inverse()) {}
+
+void MeshExactSource::sample(std::span<const glm::vec3> handPoints,
+                             std::span<const float> maxDistances,
+                             std::span<ExactSample> out) const {
+  if (handPoints.size() != maxDistances.size() || handPoints.size() != out.size()) return;
+  for (size_t i = 0; i < handPoints.size(); ++i) {
+    glm::vec3 closest(0.0f);
+    ExactSample& o = out[i];
+    o = ExactSample{};
+    o.distance = mesh_->localSignedDistanceWithin(objectFromHand_.transformPoint(handPoints[i]),
+                                                  maxDistances[i], &closest);
+    if (std::isfinite(o.distance)) o.closest = handFromObject_.transformPoint(closest);
+  }
 }
 
 }  // namespace sdfg

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -25,6 +26,7 @@
 namespace sdfg {
 
 class PhysicsCollider;  // solver_physics.h
+class MeshDistance;     // mesh_distance.h
 
 struct SolverOptions {
   float da = 0.1f;           // curl step along each finger's curve, in (0, 1]
@@ -48,6 +50,48 @@ struct GraspResult {
   // corrected hand frame, in which the fingers and contact points are, into the scene's hand
   // frame. Identity for every strategy that leaves the hand where it is.
   Pose handCorrection{};
+  // Strategies that check their stops on GraspScene::exact ("ours"): points sampled there and
+  // the wall time of that check (included in the solve), microseconds. 0 without a source.
+  int exactSamples = 0;
+  float exactCheckUs = 0.0f;
+};
+
+// One exact sample of the target's distance (ExactDistanceSource).
+struct ExactSample {
+  // Signed, metres, negative inside; +infinity when no surface is within the search distance
+  // (then the side is unknown and `closest` is not set).
+  float distance = std::numeric_limits<float>::infinity();
+  glm::vec3 closest{0.0f};  // closest surface point, in the frame of the query point
+};
+
+// Exact distance to the target at a few points, for strategies that check the stops they found
+// on the sampled field ("ours"): the field's error at 16^3 is millimetres near curved and sharp
+// parts. An interface so that a GPU path can answer a batch at once; MeshExactSource answers on
+// the CPU from a MeshDistance.
+class ExactDistanceSource {
+ public:
+  virtual ~ExactDistanceSource() = default;
+  // For each i: out[i] is the exact sample of handPoints[i] (scene hand frame) searched within
+  // maxDistances[i] metres (a small bound keeps the search cheap). The three spans must have the
+  // same size; the caller owns them. Must be safe to call from several threads at once.
+  virtual void sample(std::span<const glm::vec3> handPoints, std::span<const float> maxDistances,
+                      std::span<ExactSample> out) const = 0;
+};
+
+// ExactDistanceSource over a MeshDistance of the target in object space: hand-space points are
+// mapped by objectFromHand. Keeps a reference to `mesh` (the caller keeps it alive and does not
+// update it while solves run). The sign is MeshDistance::localSignedDistanceWithin's (the side
+// of the nearest sheet, also on open meshes).
+class MeshExactSource final : public ExactDistanceSource {
+ public:
+  MeshExactSource(const MeshDistance& mesh, const Pose& objectFromHand);
+  void sample(std::span<const glm::vec3> handPoints, std::span<const float> maxDistances,
+              std::span<ExactSample> out) const override;
+
+ private:
+  const MeshDistance* mesh_;
+  Pose objectFromHand_;
+  Pose handFromObject_;
 };
 
 // The target as the solvers see it. Only the representation a strategy asks for must be set.
@@ -55,6 +99,9 @@ struct GraspScene {
   const SdfGrid* field = nullptr;             // SDF of the target in the grab box (hand space)
   const PhysicsCollider* collider = nullptr;  // Bullet collider of the target (object space)
   Pose objectFromHand;                        // hand-space point -> object space
+  // Optional exact distance of the same target (scene hand frame). "ours" checks and corrects
+  // its stops with it; null: the field alone, as before. Other strategies ignore it.
+  const ExactDistanceSource* exact = nullptr;
 };
 
 class GraspSolver {

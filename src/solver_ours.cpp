@@ -1,7 +1,10 @@
 #include "solver_ours.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 
 #include <glm/geometric.hpp>
@@ -32,6 +35,10 @@ constexpr float kMaxPolishOpen = 0.012f;           // and opening, which is alwa
 constexpr float kMaxTrilinearOvershoot = 0.0015f;  // metres
 constexpr int kMaxPolishIterations = 8;
 constexpr int kMaxRefineIterations = 40;
+// Exact check (exactStop()): at most this many secant steps on the exact clearance, and this
+// many doubling opening steps when every pose tried was inside.
+constexpr int kMaxExactIterations = 8;
+constexpr int kMaxExactBackoff = 6;
 // Kinematics rebuilt from fingerPose() must match it this closely, else solve() asks the model.
 constexpr float kKinematicsTolerance = 2e-5f;  // metres
 
@@ -104,14 +111,6 @@ struct FastSampler {
     return c0 + (c1 - c0) * tz;
   }
 
-  // Second difference of the node values along `axis` at node p (0 at the grid's faces).
-  float secondDifference(const glm::ivec3& p, int axis) const {
-    if (p[axis] <= 0 || p[axis] >= n[axis] - 1) return 0.0f;
-    const size_t stride = axis == 0 ? 1 : (axis == 1 ? sy : sz);
-    const float* c = v + size_t(p.x) + sy * size_t(p.y) + sz * size_t(p.z);
-    return c[stride] - 2.0f * c[0] + c[-std::ptrdiff_t(stride)];
-  }
-
   // Trilinear value minus its leading error term. Linear interpolation of f between nodes h
   // apart misses t(1-t)/2 h^2 f'' at fraction t; f'' comes from the nodes' second differences,
   // blended trilinearly, so the result stays continuous. On smooth parts of a distance field
@@ -122,16 +121,26 @@ struct FastSampler {
     locate(uvw.x, scale.x, n.x, idx[0], t[0]);
     locate(uvw.y, scale.y, n.y, idx[1], t[1]);
     locate(uvw.z, scale.z, n.z, idx[2], t[2]);
+    const std::ptrdiff_t stride[3] = {1, std::ptrdiff_t(sy), std::ptrdiff_t(sz)};
+    const float* base = v + size_t(idx[0]) + sy * size_t(idx[1]) + sz * size_t(idx[2]);
     float correction = 0.0f;
     for (int axis = 0; axis < 3; ++axis) {
       const float bend = t[axis] * (1.0f - t[axis]) * 0.5f;
       if (bend <= 0.0f) continue;
+      // Along `axis`, the cell's two node layers: second differences at idx and idx + 1 (0 on
+      // the grid's faces) from four values per line, blended over the other two axes.
+      const int b = (axis + 1) % 3, c = (axis + 2) % 3;
+      const std::ptrdiff_t sa = stride[axis];
+      const bool haveLow = idx[axis] > 0, haveHigh = idx[axis] + 1 < n[axis] - 1;
       float d = 0.0f;
-      for (int c = 0; c < 8; ++c) {
-        const glm::ivec3 o(c & 1, (c >> 1) & 1, (c >> 2) & 1);
-        const float w =
-            (o.x ? t[0] : 1.0f - t[0]) * (o.y ? t[1] : 1.0f - t[1]) * (o.z ? t[2] : 1.0f - t[2]);
-        d += w * secondDifference(glm::ivec3(idx[0], idx[1], idx[2]) + o, axis);
+      for (int oc = 0; oc < 2; ++oc) {
+        for (int ob = 0; ob < 2; ++ob) {
+          const float* p = base + ob * stride[b] + oc * stride[c];
+          const float d0 = haveLow ? p[-sa] - 2.0f * p[0] + p[sa] : 0.0f;
+          const float d1 = haveHigh ? p[0] - 2.0f * p[sa] + p[2 * sa] : 0.0f;
+          const float w = (ob ? t[b] : 1.0f - t[b]) * (oc ? t[c] : 1.0f - t[c]);
+          d += w * (d0 + (d1 - d0) * t[axis]);
+        }
       }
       correction += bend * d;
     }
@@ -156,6 +165,7 @@ struct OursSolver::Stage {
   const FastSampler* sample = nullptr;
   bool lazy = false;    // false until every sphere has a sample
   float aStart = 0.0f;  // where the stage began: polish() never opens the joints past it
+  bool polish = true;   // false: the exact check replaces polish()
   std::array<float, kMaxSpheres> lastA{};
   std::array<float, kMaxSpheres> lastG{};
 };
@@ -281,6 +291,8 @@ Status OursSolver::prepare(const HandModel& hand, const GridBox& box,
       }
     }
     fr.tipSphere = fr.sphereCount - 1;
+    for (int j = 0; j <= n; ++j) fr.jointRadius[j] = hand.jointRadius(joints[j]);
+    fr.thresholdOffset = thresholdOffset;
 
     // Speed bounds: the centre of a sphere on bone b turns about every moving joint j <= b at
     // omega_j, at a distance no more than the chain length from joint j to it.
@@ -328,11 +340,10 @@ Status OursSolver::prepare(const HandModel& hand, const GridBox& box,
   return Status::ok;
 }
 
-void OursSolver::evaluate(Stage& st, const JointCurls& curls, float a, Eval& e,
-                          bool corrected) const {
-  const FingerRig& fr = fingers_[st.finger];
+void OursSolver::jointPositions(int finger, const JointCurls& curls,
+                                std::array<glm::vec3, kMaxJoints + 1>& hand) const {
+  const FingerRig& fr = fingers_[finger];
   const int n = fr.joints;
-  std::array<glm::vec3, kMaxJoints + 1> hand{};
   if (fr.ownKinematics) {
     glm::quat q(1.0f, 0.0f, 0.0f, 0.0f);
     glm::vec3 p(0.0f);
@@ -346,9 +357,17 @@ void OursSolver::evaluate(Stage& st, const JointCurls& curls, float a, Eval& e,
     hand[n] = q * fr.tipOffset + p;
   } else {
     std::array<Pose, kMaxJoints + 1> poses{};
-    hand_.fingerPose(Finger(st.finger), curls, std::span(poses.data(), n + 1));
+    hand_.fingerPose(Finger(finger), curls, std::span(poses.data(), n + 1));
     for (int j = 0; j <= n; ++j) hand[j] = poses[j].position;
   }
+}
+
+void OursSolver::evaluate(Stage& st, const JointCurls& curls, float a, Eval& e,
+                          bool corrected) const {
+  const FingerRig& fr = fingers_[st.finger];
+  const int n = fr.joints;
+  std::array<glm::vec3, kMaxJoints + 1> hand{};
+  jointPositions(st.finger, curls, hand);
   std::array<glm::vec3, kMaxJoints + 1> uvw{};
   for (int j = 0; j <= n; ++j) uvw[j] = *st.toBox * hand[j] + st.toBoxOffset;
 
@@ -429,7 +448,7 @@ float OursSolver::stage(Stage& st, JointCurls& curls, float a, int& touching, gl
   const float aStart = a;
   auto finish = [&](float v, Eval e) {
     st.aStart = aStart;
-    v = polish(st, curls, v, e);
+    if (st.polish) v = polish(st, curls, v, e);
     for (int j = firstFree; j < n; ++j) curls[j] = v;
     touching = e.arg;
     touchPoint = e.point;
@@ -579,6 +598,276 @@ float OursSolver::polish(Stage& st, JointCurls& curls, float a, Eval& e) const {
   return bestA;
 }
 
+// What exactStop() reads besides the finger: the exact source, the map from the corrected hand
+// frame (where the fingers are) to the scene's hand frame (where the source answers), and the
+// field, to choose which spheres to sample.
+struct OursSolver::ExactContext {
+  const ExactDistanceSource* source = nullptr;
+  Pose sceneFromHand;
+  const FastSampler* sample = nullptr;
+  const glm::mat3* toBox = nullptr;
+  glm::vec3 toBoxOffset{0.0f};
+};
+
+namespace {
+
+// The closest checked sphere of one pose on the exact source.
+struct ExactEval {
+  float g = std::numeric_limits<float>::infinity();  // exact clearance, metres
+  int arg = -1;                                      // sphere; -1: none within the band
+  float distance = 0.0f;                             // exact distance of its centre
+  glm::vec3 centre{0.0f};                            // its centre, corrected hand frame
+};
+
+}  // namespace
+
+// Corrects the curl of joints firstFree.. (which the field stopped at `a`) on the exact source.
+// Checked: the spheres on bones firstFree..lastBone (the ones this stop freezes) that the field
+// puts within kExactBand of touching, plus the touching one. A sphere's clearance is measured
+// against its own bone's capsule: the exact closest point q of its centre, its distance to the
+// bone's axis minus the capsule radius there (at most the centre's distance minus its radius;
+// it sees a bone that leans into the surface next to the centre). Secant steps on the smallest
+// clearance bring it into [0, kContactTolerance]. Closing past the field's stop is limited so
+// that no sphere left unchecked (distal ones included) moves more than its clearance on the
+// field; opening may go below where the group began (down to 0), which is how a sphere the
+// previous group left inside comes out. Spheres are re-chosen at every pose tried. The most
+// closed pose with no checked sphere inside is kept; if none was found, the group opens in
+// doubling steps while that helps and the least inside pose is kept. Reports the closest sphere
+// as the touching one when it is within the tolerance (or when the field said it touched).
+float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int lastBone, float a,
+                            JointCurls& curls, int& touching, glm::vec3& touchPoint,
+                            float& touchValue, int& samples) const {
+  const FingerRig& fr = fingers_[f];
+  const int n = fr.joints;
+  const float tol = kContactTolerance;
+  const std::array<float, kMaxSpheres>& speed = fr.speed[firstFree];
+  std::array<glm::vec3, kMaxJoints + 1> hand{};
+  auto setCurl = [&](float v) {
+    for (int j = firstFree; j < n; ++j) curls[j] = v;
+  };
+  auto centreOf = [&](const Sphere& s) {
+    return hand[s.bone] + s.t * (hand[s.bone + 1] - hand[s.bone]);
+  };
+
+  std::array<int, kMaxSpheres> cand{};
+  std::array<bool, kMaxSpheres> isCand{};
+  int count = 0;
+  float maxSpeed = 0.0f;  // over the candidates
+  std::array<glm::vec3, 1> points{};
+  std::array<float, 1> bounds{};
+  std::array<ExactSample, 1> found{};
+  // Each candidate's last exact clearance (or the lower bound a bounded search gave) and curl:
+  // the centre's distance is 1-Lipschitz and moves at most speed * |da|, so a candidate whose
+  // bound stays kLazyMargin above the smallest one cannot be the closest and is not sampled.
+  // `fresh`: not sampled yet (searched over the whole band).
+  std::array<float, kMaxSpheres> lastG{}, lastA{};
+  std::array<bool, kMaxSpheres> fresh{};
+  // Candidates are chosen on the field at every pose tried: a sphere of the frozen bones that
+  // comes within the band joins them. Every other moving sphere (distal ones too) limits how
+  // far the group may close from here: no more than its clearance on the field allows (the
+  // interpolant's slope bound), so none reaches the surface unseen. `highest`: that limit.
+  float highest = 1.0f;
+  auto select = [&](float v) {
+    float reach = 1.0f - v;
+    for (int i = 0; i < fr.sphereCount; ++i) {
+      const Sphere& s = fr.spheres[i];
+      if (s.bone < firstFree || isCand[i]) continue;
+      const glm::vec3 uvw = *cx.toBox * centreOf(s) + cx.toBoxOffset;
+      const float value = (*cx.sample)(uvw);
+      float g = value - s.testRadius;
+      // As in evaluate(): the corrected reading only matters where it can be lower.
+      if (g < kExactBand + kCorrectBand) {
+        g = std::min(value, cx.sample->corrected(uvw, value)) - s.testRadius;
+      }
+      if (s.bone <= lastBone && (g < kExactBand || i == touching)) {
+        isCand[i] = true;
+        fresh[count] = true;
+        lastA[count] = v;
+        lastG[count] = -kExactBand;
+        cand[count++] = i;
+        maxSpeed = std::max(maxSpeed, speed[i]);
+      } else if (speed[i] > 0.0f) {
+        reach = std::min(reach, std::max(g, 0.0f) / (kInterpolantLipschitz * speed[i]));
+      }
+    }
+    highest = std::min(1.0f, v + reach);
+  };
+  setCurl(a);
+  jointPositions(f, curls, hand);
+  select(a);
+  if (count == 0 || !(maxSpeed > 0.0f)) return a;
+
+  // Samples candidate k at the current joint positions; returns its clearance (or the lower
+  // bound the bounded search gave) and records it.
+  auto sampleOne = [&](int k, float v, ExactEval& r) {
+    const Sphere& s = fr.spheres[cand[k]];
+    const float radius = s.radius + fr.thresholdOffset;
+    points[0] = cx.sceneFromHand.transformPoint(centreOf(s));
+    const float upper = fresh[k] ? kExactBand : lastG[k] + speed[cand[k]] * std::abs(v - lastA[k]);
+    fresh[k] = false;
+    bounds[0] = radius + std::clamp(upper + 0.0005f, 0.0005f, kExactBand);
+    cx.source->sample(std::span(points.data(), 1), std::span(bounds.data(), 1),
+                      std::span(found.data(), 1));
+    ++samples;
+    lastA[k] = v;
+    if (!std::isfinite(found[0].distance)) {  // clear by more than the search distance
+      lastG[k] = bounds[0] - radius;
+      return;
+    }
+    float g = found[0].distance - radius;
+    if (found[0].distance > 0.0f) {
+      // The sphere at the proximal joint (bone 0, t = 1) starts the first phalanx's capsule.
+      const int b = s.bone == 0 ? 1 : s.bone;
+      const glm::vec3 pa = cx.sceneFromHand.transformPoint(hand[b]);
+      const glm::vec3 pb = cx.sceneFromHand.transformPoint(hand[b + 1]);
+      const glm::vec3 axis = pb - pa;
+      const float len2 = glm::dot(axis, axis);
+      const float t =
+          len2 > 0.0f ? std::clamp(glm::dot(found[0].closest - pa, axis) / len2, 0.0f, 1.0f) : 0.0f;
+      const float rr =
+          fr.jointRadius[b] + t * (fr.jointRadius[b + 1] - fr.jointRadius[b]) + fr.thresholdOffset;
+      g = std::min(g, glm::length(found[0].closest - (pa + t * axis)) - rr);
+    }
+    lastG[k] = g;
+    if (g < r.g) {
+      r.g = g;
+      r.arg = cand[k];
+      r.distance = found[0].distance;
+      r.centre = centreOf(s);
+    }
+  };
+  // The smallest clearance over the candidates: sampled in order of their lower bounds, until
+  // the smallest found is below every bound left (those cannot be nearer, nor inside when it
+  // is not). Returns how many were sampled.
+  auto measureOnce = [&](float v, ExactEval& r) {
+    std::array<float, kMaxSpheres> lower{};
+    std::array<int, kMaxSpheres> order{};
+    for (int k = 0; k < count; ++k) {
+      lower[k] = fresh[k] ? -std::numeric_limits<float>::infinity()
+                          : lastG[k] - speed[cand[k]] * std::abs(v - lastA[k]);
+      int pos = k;
+      while (pos > 0 && lower[order[pos - 1]] > lower[k]) {
+        order[pos] = order[pos - 1];
+        --pos;
+      }
+      order[pos] = k;
+    }
+    r = ExactEval{};
+    int m = 0;
+    for (int q = 0; q < count; ++q) {
+      const int k = order[q];
+      if (lower[k] >= r.g) break;
+      sampleOne(k, v, r);
+      ++m;
+    }
+    return m;
+  };
+  // Nothing sampled near: the spheres skipped may be nearer than their bounds say (opening
+  // moves them away, which a speed bound cannot tell), so all are searched over the band.
+  auto measure = [&](float v, ExactEval& r) {
+    setCurl(v);
+    jointPositions(f, curls, hand);
+    select(v);
+    if (measureOnce(v, r) < count && r.arg < 0) {
+      for (int k = 0; k < count; ++k) fresh[k] = true;
+      measureOnce(v, r);
+    }
+    if (r.arg < 0) {
+      r.g = kExactBand;
+      for (int k = 0; k < count; ++k) r.g = std::min(r.g, lastG[k]);
+    }
+  };
+
+  ExactEval cur;
+  measure(a, cur);
+  if (cur.arg < 0 && touching < 0) {  // nothing near: the field's pose stands
+    setCurl(a);
+    return a;
+  }
+  float aCur = a, aPrev = a, gPrev = 0.0f;
+  bool havePrev = false;
+  int argPrev = -1;
+  float aSafe = -1.0f, aOpen = a;  // most closed pose with nothing inside; most open tried
+  ExactEval safe, open = cur, least = cur;
+  float aLeast = a;  // the pose with the largest clearance tried
+  for (int it = 0;; ++it) {
+    if (cur.g >= 0.0f && aCur > aSafe) {
+      aSafe = aCur;
+      safe = cur;
+    }
+    if (aCur < aOpen) {
+      aOpen = aCur;
+      open = cur;
+    }
+    if (cur.g > least.g) {
+      aLeast = aCur;
+      least = cur;
+    }
+    if ((cur.g >= 0.0f && cur.g <= tol) || it >= kMaxExactIterations) break;
+    const float argSpeed = cur.arg >= 0 ? std::max(speed[cur.arg], 1e-4f) : maxSpeed;
+    // A secant only through two samples of the same sphere.
+    const float slope =
+        havePrev && argPrev == cur.arg && aCur != aPrev ? (cur.g - gPrev) / (aCur - aPrev) : 0.0f;
+    float next;
+    if (slope < 0.0f) {
+      next = aCur + (0.5f * tol - cur.g) / slope;
+    } else if (cur.g > 0.0f) {
+      // The closest sphere does not come nearer as the group closes (it slides along
+      // the surface): advance conservatively, no checked sphere moving more than its
+      // clearance.
+      next = aCur + std::max(cur.g, 0.001f) / maxSpeed;
+    } else {
+      next = aCur + (0.5f * tol - cur.g) / -argSpeed;
+    }
+    // Opening is safe but a flat secant can ask for far too much: a few times the
+    // least needed.
+    next = std::max(next, aCur - 4.0f * (std::abs(cur.g) + 0.0005f) / argSpeed);
+    // The group may open below where it started: a sphere the previous group left
+    // inside (it was distal to that group's check) can only come out by opening this
+    // group further.
+    const float lowest = 0.0f;
+    next = std::clamp(next, lowest, highest);
+    // Never close past a pose known to be inside, nor open past one known to be
+    // clear.
+    if (aSafe >= 0.0f && next < aSafe) next = aSafe + 0.5f * (aCur - aSafe);
+    if (std::abs(next - aCur) < 1e-7f) break;
+    aPrev = aCur;
+    gPrev = cur.g;
+    argPrev = cur.arg;
+    havePrev = true;
+    aCur = next;
+    measure(aCur, cur);
+  }
+  if (aSafe < 0.0f) {
+    // Everything tried was inside: open from the most open pose in doubling steps
+    // while that helps (a part behind the finger gets deeper as it opens), then keep
+    // the least inside.
+    const float s0 = std::max(-open.g, 0.0005f) / std::max(speed[std::max(open.arg, 0)], 1e-3f);
+    for (int k = 0; k < kMaxExactBackoff && aOpen > 0.0f; ++k) {
+      const float v = std::max(0.0f, aOpen - s0 * float(1 << k));
+      ExactEval e;
+      measure(v, e);
+      const bool better = e.g > open.g;
+      aOpen = v;
+      open = e;
+      if (e.g > least.g) {
+        aLeast = v;
+        least = e;
+      }
+      if (e.g >= 0.0f || !better) break;
+    }
+    aSafe = aLeast;
+    safe = least;
+  }
+  setCurl(aSafe);
+  if (safe.arg >= 0 && (touching >= 0 || safe.g <= tol)) {
+    touching = safe.arg;
+    touchPoint = safe.centre;
+    touchValue = safe.distance;
+  }
+  return aSafe;
+}
+
 Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {
   if (!prepared_) return Status::invalid_argument;
   if (scene.field == nullptr) return Status::invalid_argument;
@@ -596,6 +885,14 @@ Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {
   glm::vec3 toBoxOffset;
   normalizedMap(field.box(), out.handCorrection, toBox, toBoxOffset);
   const FastSampler sampler(field);
+  ExactContext cx;
+  cx.source = scene.exact;
+  cx.sceneFromHand = out.handCorrection;
+  cx.sample = &sampler;
+  cx.toBox = &toBox;
+  cx.toBoxOffset = toBoxOffset;
+  using Clock = std::chrono::steady_clock;
+  Clock::duration checkTime{0};
 
   for (int f = 0; f < kFingerCount; ++f) {
     const FingerRig& fr = fingers_[f];
@@ -614,7 +911,15 @@ Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {
       st.toBox = &toBox;
       st.toBoxOffset = toBoxOffset;
       st.sample = &sampler;
+      st.polish = scene.exact == nullptr;
       a = stage(st, curls, a, touching, point, value);
+      if (scene.exact != nullptr) {
+        const Clock::time_point t0 = Clock::now();
+        const int lastBone = touching >= 0 ? int(fr.spheres[touching].bone) : n - 1;
+        a = exactStop(cx, f, firstFree, lastBone, a, curls, touching, point, value,
+                      out.exactSamples);
+        checkTime += Clock::now() - t0;
+      }
       if (touching < 0) break;
       // The most distal contact is the one reported: it is where the finger ends up resting.
       state.contact = true;
@@ -628,6 +933,9 @@ Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {
     // the single-curl pose at that value is the first contact, free of the object.
     state.curl = curls[0];
     for (int j = 1; j < n; ++j) state.curl = std::min(state.curl, curls[j]);
+  }
+  if (scene.exact != nullptr) {
+    out.exactCheckUs = std::chrono::duration<float, std::micro>(checkTime).count();
   }
   return Status::ok;
 }

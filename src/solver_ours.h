@@ -13,6 +13,13 @@
 //   its leading h^2 error term), which is what takes a 16^3 field from about 1 mm to about
 //   0.1 mm of the true surface on smooth parts. Every pose is checked against the field it
 //   stops on: no sphere ends inside it.
+// - Exact check (when GraspScene::exact is set): the field's error near curved and sharp parts
+//   (millimetres at 16^3) is removed where it matters. After each joint group stops on the
+//   field, the spheres it moved that the field puts within kExactBand of touching are sampled
+//   exactly (bounded searches), their clearance measured against their own capsule, and the
+//   group's curl corrected by secant steps on that exact clearance until the closest one is
+//   within kContactTolerance of touching and none is inside (opening further if needed). The
+//   field's own polish is skipped then; without a source nothing changes.
 // - Approach (optional, SolverOptions::approach): approachPose() follows the field's gradient
 //   from the palm to turn and move the hand onto the surface before the fingers close.
 //
@@ -70,6 +77,8 @@ class OursSolver final : public GraspSolver {
   static constexpr int kMaxJoints = 4;
   // A finger is in contact once its closest sphere is within this of its threshold.
   static constexpr float kContactTolerance = 0.0001f;  // metres
+  // Exact check: spheres the field puts within this of touching are sampled exactly.
+  static constexpr float kExactBand = 0.004f;  // metres
 
   std::string_view name() const override { return "ours"; }
   bool needsField() const override { return true; }
@@ -108,6 +117,8 @@ class OursSolver final : public GraspSolver {
     std::array<float, kMaxJoints> minStep{};  // smallest curl step per stage (0.5 mm of motion)
     std::array<float, kMaxJoints> maxJump{};  // largest secant jump per stage
     int tipSphere = 0;
+    std::array<float, kMaxJoints + 1> jointRadius{};  // capsule radius at each joint
+    float thresholdOffset = 0.0f;                     // SolverOptions::threshold - tip radius
     bool ownKinematics = true;  // false: the model's curve is not a per-joint slerp; ask it
   };
   struct Eval;
@@ -117,6 +128,12 @@ class OursSolver final : public GraspSolver {
               float& touchValue) const;
   void evaluate(Stage& st, const JointCurls& curls, float a, Eval& e, bool corrected) const;
   float polish(Stage& st, JointCurls& curls, float a, Eval& e) const;
+  void jointPositions(int finger, const JointCurls& curls,
+                      std::array<glm::vec3, kMaxJoints + 1>& hand) const;
+  struct ExactContext;
+  float exactStop(const ExactContext& cx, int finger, int firstFree, int lastBone, float a,
+                  JointCurls& curls, int& touching, glm::vec3& touchPoint, float& touchValue,
+                  int& samples) const;
 
   HandModel hand_{};
   GridBox box_{};

@@ -378,3 +378,56 @@ TEST_CASE("signedDistances over 2x2x2 blocks equals brute force and signedDistan
     CHECK(values == std::vector<float>(2, 7.0f));
   }
 }
+
+TEST_CASE("localSignedDistanceWithin: signedDistance within its bound, infinity beyond",
+          "[mesh_distance][local]") {
+  const TriangleMesh sphere = icosphereMesh(0.05f, 3);
+  const auto d = makeDistance(sphere);
+  std::mt19937 rng(11);
+  const std::vector<glm::vec3> points = samplePoints(sphere, 300, 100, 0.02f, rng);
+  int within = 0, beyond = 0;
+  for (const glm::vec3& p : points) {
+    const float sd = d->signedDistance(p);
+    CAPTURE(p.x, p.y, p.z, sd);
+    for (float bound : {0.005f, 0.02f}) {
+      glm::vec3 q(1e9f);
+      const float local = d->localSignedDistanceWithin(p, bound, &q);
+      if (std::abs(sd) <= bound * 0.999f) {
+        ++within;
+        // On a closed mesh the pseudo-normal side is signedDistance's sign.
+        CHECK(local == Approx(sd).margin(1e-6f));
+        CHECK(glm::length(p - q) == Approx(std::abs(sd)).margin(1e-6f));
+      } else if (std::abs(sd) > bound * 1.001f) {
+        ++beyond;
+        CHECK(std::isinf(local));
+        CHECK(q.x == 1e9f);  // not written
+      }
+    }
+  }
+  CHECK(within > 100);
+  CHECK(beyond > 100);
+  CHECK(std::isinf(d->localSignedDistanceWithin(glm::vec3(0.0f), -1.0f)));
+}
+
+TEST_CASE("localSignedDistanceWithin on the open bunny agrees with ray parity near the surface",
+          "[mesh_distance][local][shared]") {
+  const TriangleMesh* m = normalizedSharedMesh("stanford-bunny.obj");
+  if (m == nullptr) SDFG_SKIP("shared mesh missing: stanford-bunny.obj");
+  const auto d = makeDistance(*m);
+  REQUIRE_FALSE(d->isClosed());
+  std::mt19937 rng(12);
+  // Near the surface (where a finger check asks) but not on it: within 3 to 10 mm.
+  const std::vector<glm::vec3> points = samplePoints(*m, 400, 0, 0.012f, rng);
+  int judged = 0, disagree = 0;
+  for (const glm::vec3& p : points) {
+    const float local = d->localSignedDistanceWithin(p, 0.02f);
+    if (!std::isfinite(local) || std::abs(local) < 0.003f) continue;
+    const int vote = rayParityVote(*m, p, rng);
+    if (vote == 0) continue;
+    ++judged;
+    if ((local < 0.0f) != (vote > 0)) ++disagree;
+  }
+  CHECK(judged > 100);
+  // The sheet's side is the solid's side except near the holes in the base.
+  CHECK(disagree <= judged / 50);
+}

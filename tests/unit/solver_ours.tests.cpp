@@ -1,12 +1,13 @@
 // The "ours" strategy on analytic shapes whose exact answer is known: plane, sphere, a thin
 // plate that fixed steps skip, a cylinder handle the fingers wrap around; the approach step and
-// the holder's smoothing.
+// the holder's smoothing; the exact check of the stops (GraspScene::exact) on the same shapes.
 #include <algorithm>
 #include <cmath>
 #include <ctime>
 #include <functional>
 #include <iostream>
 #include <random>
+#include <span>
 #include <vector>
 
 #include <catch2/catch.hpp>
@@ -14,7 +15,9 @@
 
 #include "grasp_holder.h"
 #include "hand_model.h"
+#include "mesh_distance.h"
 #include "sdf_grid.h"
+#include "shapes.h"
 #include "solver.h"
 #include "solver_ours.h"
 
@@ -445,4 +448,172 @@ TEST_CASE("solve budget: re-solves on change within budget, defers when over", "
   int frames = 0;
   while (!budget.shouldSolve(frames == 0) && frames < 10) ++frames;
   CHECK(frames == SolveBudget::kMaxSkippedFrames);
+}
+
+namespace {
+
+// An exact source from a distance function: the closest point is p - d * gradient (central
+// differences), which is exact for the shapes below away from their medial axes. Counts the
+// points it was asked about.
+class AnalyticExact final : public ExactDistanceSource {
+ public:
+  explicit AnalyticExact(DistanceFn fn) : fn_(std::move(fn)) {}
+  void sample(std::span<const glm::vec3> points, std::span<const float> maxDistances,
+              std::span<ExactSample> out) const override {
+    for (size_t i = 0; i < points.size(); ++i) {
+      ++calls_;
+      out[i] = ExactSample{};
+      const glm::vec3& p = points[i];
+      const float d = fn_(p);
+      if (std::abs(d) > maxDistances[i]) continue;
+      const float h = 1e-5f;
+      glm::vec3 g(fn_(p + glm::vec3(h, 0, 0)) - fn_(p - glm::vec3(h, 0, 0)),
+                  fn_(p + glm::vec3(0, h, 0)) - fn_(p - glm::vec3(0, h, 0)),
+                  fn_(p + glm::vec3(0, 0, h)) - fn_(p - glm::vec3(0, 0, h)));
+      g = glm::length(g) > 0.0f ? glm::normalize(g) : glm::vec3(0.0f);
+      out[i].distance = d;
+      out[i].closest = p - d * g;
+    }
+  }
+  int calls() const { return calls_; }
+
+ private:
+  DistanceFn fn_;
+  mutable int calls_ = 0;
+};
+
+Solved solveOursExact(const SdfGrid& grid, const ExactDistanceSource* exact) {
+  const HandModel hand = HandModel::defaultAdult(Hand::right);
+  OursSolver solver;
+  REQUIRE(solver.prepare(hand, grid.box(), SolverOptions{}) == Status::ok);
+  GraspScene scene;
+  scene.field = &grid;
+  scene.exact = exact;
+  Solved s;
+  s.status = solver.solve(scene, s.result);
+  return s;
+}
+
+// Smallest exact (distance - radius) over a finger's dense capsule.
+float exactCapsuleClearance(const DistanceFn& fn, const HandModel& hand, Finger finger,
+                            const JointCurls& curls) {
+  float best = 1e9f;
+  for (const CapsulePoint& c : capsule(hand, finger, curls))
+    best = std::min(best, fn(c.centre) - c.radius);
+  return best;
+}
+
+}  // namespace
+
+TEST_CASE("ours with an exact source: contacts end within 0.1 mm of touching, none inside",
+          "[solver][ours][exact]") {
+  const HandModel hand = HandModel::defaultAdult(Hand::right);
+  struct Shape {
+    const char* name;
+    DistanceFn fn;
+  };
+  const glm::vec3 plateCentre(0.0f, -0.03f, -0.17f), plateHalf(0.1f, 0.002f, 0.03f);
+  const Shape shapes[] = {
+      {"sphere under the fingers",
+       [](const glm::vec3& p) {
+         return glm::length(p - glm::vec3(0.0f, -0.07f, -0.11f)) - 0.035f;
+       }},
+      {"box under the fingers",
+       [](const glm::vec3& p) {
+         return boxDistance(p, glm::vec3(0.0f, -0.08f, -0.12f), glm::vec3(0.08f, 0.025f, 0.03f));
+       }},
+      {"4 mm plate across the finger paths",
+       [&](const glm::vec3& p) { return boxDistance(p, plateCentre, plateHalf); }},
+  };
+  for (const Shape& shape : shapes) {
+    DYNAMIC_SECTION(shape.name << " on a 16^3 field") {
+      const SdfGrid grid = analyticGrid(shape.fn, 16);
+      const AnalyticExact exact(shape.fn);
+      const Solved s = solveOursExact(grid, &exact);
+      REQUIRE(s.status == Status::ok);
+      CHECK(s.result.exactSamples > 0);
+      CHECK(s.result.exactSamples == exact.calls());
+      int contacts = 0;
+      for (int f = 0; f < kFingerCount; ++f) {
+        const FingerState& st = s.result.fingers[f];
+        const float clearance = exactCapsuleClearance(shape.fn, hand, Finger(f), st.jointCurls);
+        CAPTURE(fingerName(Finger(f)), st.curl, st.contact, clearance);
+        // Nothing inside: not the dense capsule (the evaluator's model) beyond 0.1 mm, nor on
+        // the way there (the check's closing moves are bounded, so it cannot tunnel either).
+        CHECK(clearance >= -1e-4f);
+        CHECK_FALSE(sweptThrough(shape.fn, hand, Finger(f), st.curl));
+        if (st.contact) {
+          ++contacts;
+          // The touching sphere is within 0.1 mm of the surface, by the exact distance...
+          CHECK(shape.fn(st.contactPoint) == Approx(st.distance).margin(1e-6f));
+          // ...and so is the finger's capsule.
+          CHECK(clearance <= 1e-4f);
+        }
+      }
+      CHECK(contacts >= 3);
+    }
+  }
+}
+
+TEST_CASE("ours without an exact source samples nothing and solves as on the field alone",
+          "[solver][ours][exact]") {
+  const DistanceFn sphere = [](const glm::vec3& p) {
+    return glm::length(p - glm::vec3(0.0f, -0.07f, -0.11f)) - 0.035f;
+  };
+  const SdfGrid grid = analyticGrid(sphere, 16);
+  const Solved plain = solveOurs(grid);
+  const Solved none = solveOursExact(grid, nullptr);
+  REQUIRE(plain.status == Status::ok);
+  REQUIRE(none.status == Status::ok);
+  CHECK(none.result.exactSamples == 0);
+  CHECK(none.result.exactCheckUs == 0.0f);
+  for (int f = 0; f < kFingerCount; ++f) {
+    CAPTURE(fingerName(Finger(f)));
+    CHECK(none.result.fingers[f].contact == plain.result.fingers[f].contact);
+    for (int j = 0; j < 4; ++j)
+      CHECK(none.result.fingers[f].jointCurls[j] == plain.result.fingers[f].jointCurls[j]);
+  }
+  // The exact check moves the stops: the field alone is about a millimetre off at 16^3.
+  const AnalyticExact exact(sphere);
+  const Solved checked = solveOursExact(grid, &exact);
+  REQUIRE(checked.status == Status::ok);
+  bool moved = false;
+  for (int f = 0; f < kFingerCount; ++f)
+    moved = moved || checked.result.fingers[f].jointCurls != plain.result.fingers[f].jointCurls;
+  CHECK(moved);
+}
+
+TEST_CASE("ours with MeshExactSource: contacts on a box mesh end within 0.1 mm of touching",
+          "[solver][ours][exact]") {
+  const HandModel hand = HandModel::defaultAdult(Hand::right);
+  const glm::vec3 centre(0.0f, -0.08f, -0.12f), half(0.08f, 0.025f, 0.03f);
+  const DistanceFn box = [&](const glm::vec3& p) { return boxDistance(p, centre, half); };
+  auto mesh = MeshDistance::create(makeBox(2.0f * half));
+  REQUIRE(mesh.ok());
+  // The box mesh is centred on the origin of its object frame.
+  Pose objectFromHand;
+  objectFromHand.position = -centre;
+  const MeshExactSource exact(**mesh, objectFromHand);
+  const SdfGrid grid = analyticGrid(box, 16);
+  OursSolver solver;
+  REQUIRE(solver.prepare(hand, grid.box(), SolverOptions{}) == Status::ok);
+  GraspScene scene;
+  scene.field = &grid;
+  scene.objectFromHand = objectFromHand;
+  scene.exact = &exact;
+  GraspResult out;
+  REQUIRE(solver.solve(scene, out) == Status::ok);
+  CHECK(out.exactSamples > 0);
+  int contacts = 0;
+  for (int f = 0; f < kFingerCount; ++f) {
+    const FingerState& st = out.fingers[f];
+    const float clearance = exactCapsuleClearance(box, hand, Finger(f), st.jointCurls);
+    CAPTURE(fingerName(Finger(f)), st.contact, clearance);
+    CHECK(clearance >= -1e-4f);
+    if (st.contact) {
+      ++contacts;
+      CHECK(clearance <= 1e-4f);
+    }
+  }
+  CHECK(contacts >= 3);
 }

@@ -17,6 +17,7 @@ struct Config {
   float releaseRatio = 0.8f;           // release_ratio: a grab ends below threshold * ratio
   unsigned resolution = 16;            // resolution: grid nodes per axis, 2..128
   float curlStep = 0.02f;              // curl_step: solver step along each finger curve
+  bool exactCheck = true;              // exact_check: "ours" checks stops on the exact mesh
   bool synthesis = true;               // synthesis: offer XR_EXT_hand_tracking from controllers
   // gpu: where Vulkan sessions build the SDFs of array targets. auto: on the app's device unless
   // it is a CPU implementation (lavapipe, SwiftShader), where the CPU builder is faster and the

@@ -86,6 +86,7 @@ GraspSettings settingsFromConfig(const Config& config) {
   GraspSettings s;
   s.solver = resolveSolverName(config.solver);
   s.solverOptions.da = config.curlStep;
+  s.exactCheck = config.exactCheck;
   s.box.resolution = glm::uvec3(config.resolution);
   s.grabThreshold = config.grabThreshold;
   s.releaseRatio = config.releaseRatio;

@@ -214,14 +214,19 @@ Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Targ
       s != Status::ok)
     return s;
   ++stats_.cpuBuilds;
-  return solveWithGrid(hand, objectFromHand, target.version, false);
+  return solveWithGrid(hand, objectFromHand, target.version, false, target.distance.get());
 }
 
 Status GraspSession::solveWithGrid(HandState& hand, const Pose& objectFromHand, uint64_t version,
-                                   bool gpu) {
+                                   bool gpu, const MeshDistance* exactMesh) {
   GraspScene scene;
   scene.field = &hand.grid;
   scene.objectFromHand = objectFromHand;
+  std::optional<MeshExactSource> exact;
+  if (settings_.exactCheck && exactMesh != nullptr) {
+    exact.emplace(*exactMesh, objectFromHand);
+    scene.exact = &*exact;
+  }
   GraspResult result;
   if (Status s = hand.solver->solve(scene, result); s != Status::ok) return s;
   hand.grasp.result = result;
@@ -246,7 +251,8 @@ Status GraspSession::collect(HandState& hand, size_t slot) {
   if (p == BuildPoll::ready) {
     ++stats_.gpuBuilds;
     // A result for older vertices is still shown; the next update asks again.
-    return solveWithGrid(hand, hand.pendingPose, hand.pendingVersion, true);
+    return solveWithGrid(hand, hand.pendingPose, hand.pendingVersion, true,
+                         it->second.distance.get());
   }
   // The device failed (or lost the request): redo the build on the CPU now.
   if (p == BuildPoll::failed) stats_.gpuFailed = true;
@@ -260,7 +266,8 @@ Status GraspSession::collect(HandState& hand, size_t slot) {
     return s;
   }
   ++stats_.cpuBuilds;
-  return solveWithGrid(hand, hand.pendingPose, hand.pendingVersion, false);
+  return solveWithGrid(hand, hand.pendingPose, hand.pendingVersion, false,
+                       it->second.distance.get());
 }
 
 Status GraspSession::update(Hand side, const HandFrame& frame,

@@ -215,7 +215,15 @@ TEST_CASE("A squeezed hand closes onto the Stanford bunny within 2 mm", "[layer]
   const XrPosef pose = underOpenPalm(bunny, grip);
   GraspOutcome out = graspScene(bunny, pose, grip);
   ExactDistance exact(bunny, pose);
-  checkContacts(out, [&](const XrVector3f& p) { return exact(p); });
+  const auto distance = [&](const XrVector3f& p) { return exact(p); };
+  checkContacts(out, distance);
+  // The default strategy (ours, exact_check on) checks each stop on the mesh itself, so its
+  // contacts are far tighter than the 2 mm the 16^3 field alone allows.
+  for (int f = 0; f < 5; ++f) {
+    if (!out.state.fingers[f].inContact) continue;
+    CAPTURE(f);
+    CHECK(std::abs(fingerClearance(out, f, distance)) <= 0.0002f);
+  }
 }
 
 TEST_CASE("Destroying a held target lets the hand go back to the user's pose", "[layer][grasp]") {

@@ -361,3 +361,41 @@ TEST_CASE("The far-field band is validated", "[sdf_cpu][far]") {
     CHECK(builder.build(*d, kObjectFromHand, bad, grid, options) == Status::invalid_argument);
   }
 }
+
+TEST_CASE("Timing of the far-field mode against exact builds", "[.][timing][far]") {
+  using Clock = std::chrono::steady_clock;
+  for (const char* name :
+       {"stanford-armadillo-100k.obj", "stanford-dragon-100k.obj", "stanford-bunny.obj"}) {
+    const TriangleMesh* m = normalizedSharedMesh(name);
+    if (m == nullptr) SDFG_SKIP("shared meshes missing");
+    const auto d = makeDistance(*m);
+    for (unsigned threads : {1u, 2u}) {
+      CpuSdfBuilder builder(threads);
+      std::mt19937 rng(3);
+      std::vector<GridBox> boxes;
+      for (int b = 0; b < 20; ++b) {
+        const glm::vec3 v = m->positions[rng() % m->positions.size()];
+        GridBox box = GridBox::referenceDefault();
+        box.handFromBox.position = v + 0.04f * glm::normalize(v + glm::vec3(1e-3f));
+        boxes.push_back(box);
+      }
+      for (const float spacings : {0.0f, 1.0f, 2.0f, 3.0f}) {
+        CpuSdfOptions options;
+        options.exactBand = spacings * boxes[0].maxSpacing();
+        std::vector<double> ms;
+        size_t exact = 0;
+        SdfGrid grid;
+        for (const GridBox& box : boxes) {
+          const auto s = Clock::now();
+          REQUIRE(builder.build(*d, Pose{}, box, grid, options) == Status::ok);
+          ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - s).count());
+          exact += builder.lastExactNodes();
+        }
+        std::sort(ms.begin(), ms.end());
+        std::cout << name << " band " << spacings << " h: median " << ms[ms.size() / 2] << " ms ("
+                  << threads << " threads), exact nodes " << 100.0 * double(exact) / (20.0 * 4096.0)
+                  << " %\n";
+      }
+    }
+  }
+}

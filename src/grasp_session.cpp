@@ -11,15 +11,17 @@ namespace {
 
 class CpuBackend final : public SdfBackend {
  public:
-  explicit CpuBackend(unsigned threads) : builder_(threads) {}
+  CpuBackend(unsigned threads, const CpuSdfOptions& options)
+      : builder_(threads), options_(options) {}
   std::string_view name() const override { return "cpu"; }
   Status build(const MeshDistance& target, const Pose& objectFromHand, const GridBox& box,
                SdfGrid& out) override {
-    return builder_.build(target, objectFromHand, box, out);
+    return builder_.build(target, objectFromHand, box, out, options_);
   }
 
  private:
   CpuSdfBuilder builder_;
+  CpuSdfOptions options_;
 };
 
 float angleBetween(const glm::quat& a, const glm::quat& b) {
@@ -29,8 +31,8 @@ float angleBetween(const glm::quat& a, const glm::quat& b) {
 
 }  // namespace
 
-std::unique_ptr<SdfBackend> makeCpuSdfBackend(unsigned threads) {
-  return std::make_unique<CpuBackend>(threads);
+std::unique_ptr<SdfBackend> makeCpuSdfBackend(unsigned threads, const CpuSdfOptions& options) {
+  return std::make_unique<CpuBackend>(threads, options);
 }
 
 std::optional<Error> GraspSettings::validate() const {

@@ -478,4 +478,13 @@ float MeshDistance::windingNumber(const glm::vec3& p) const {
   return float(impl_->winding(p));
 }
 
+bool MeshDistance::signsByWinding() const {
+  return !impl_->pseudoNormalSign;
+}
+
+float MeshDistance::windingSign(const glm::vec3& p) const {
+  impl_->ensureClusters();
+  return impl_->winding(p) > 0.5 ? -1.0f : 1.0f;
+}
+
 }  // namespace sdfg

@@ -73,6 +73,12 @@ class MeshDistance {
                          std::span<float> distances) const;
   // Generalized winding number: ~1 inside, ~0 outside, fractional near holes.
   float windingNumber(const glm::vec3& p) const;
+  // Whether the distance queries take their sign from the winding number (open, non-manifold or
+  // inconsistently oriented meshes) rather than from pseudo-normals.
+  bool signsByWinding() const;
+  // -1 where the winding number exceeds 1/2, else +1: on a mesh signsByWinding(), exactly the sign
+  // the distance queries give at `p` (the same double-precision comparison), without the search.
+  float windingSign(const glm::vec3& p) const;
 
  private:
   struct Impl;

@@ -10,6 +10,7 @@
 #include "mesh.h"
 #include "mesh_distance.h"
 #include "pose.h"
+#include "sdf_cpu.h"
 #include "sdf_grid.h"
 #include "status.h"
 
@@ -27,7 +28,9 @@ class SdfBackend {
 };
 
 // The CPU builder (CpuSdfBuilder) behind the interface; threads == 0: one per hardware thread.
-std::unique_ptr<SdfBackend> makeCpuSdfBackend(unsigned threads);
+// `options` (validated at each build: a bad band fails the build with invalid_argument) can turn
+// on the far-field mode; the default is exact at every node.
+std::unique_ptr<SdfBackend> makeCpuSdfBackend(unsigned threads, const CpuSdfOptions& options = {});
 
 enum class BuildPoll {
   idle,     // nothing requested for the slot

@@ -3,8 +3,14 @@
 // The fallback path when no Vulkan device can be used, and the reference the GPU path is tested
 // against. Work is split over a pool of worker threads owned by the builder, so repeated builds
 // (one per grab, or per frame while holding) pay no thread start-up.
+//
+// Optional far-field mode (CpuSdfOptions::exactBand > 0): nodes proven at least `exactBand` from
+// the surface get a certified lower bound of their distance, with the exact builder's sign,
+// instead of an exact query (the expensive ones: far from the surface a query visits many
+// leaves). Every node closer than the band is exact. See sdf_cpu.cpp for the proofs.
 #pragma once
 
+#include <cstddef>
 #include <memory>
 
 #include "mesh_distance.h"
@@ -13,6 +19,16 @@
 #include "status.h"
 
 namespace sdfg {
+
+struct CpuSdfOptions {
+  // Metres. 0: every node exact (the reference, the default). > 0: a node whose distance to the
+  // surface is below exactBand holds the exact signed distance; any other node may instead hold
+  // sign * b with the exact sign and exactBand <= b <= |exact distance|. The node values stay
+  // 1-Lipschitz along grid edges (each axis difference at most the spacing), as exact distances
+  // are. Must be finite and >= 0, else build() fails with invalid_argument. With exactBand at
+  // least sqrt(3) spacings, every grid cell the surface crosses has only exact corners.
+  float exactBand = 0.0f;
+};
 
 class CpuSdfBuilder {
  public:
@@ -26,10 +42,19 @@ class CpuSdfBuilder {
   // `objectFromHand` places hand-space points in the mesh's space. Fails on an invalid box.
   Status build(const MeshDistance& target, const Pose& objectFromHand, const GridBox& box,
                SdfGrid& out);
+  // As above, with `options` (see CpuSdfOptions); the grid's exactBand() records the band.
+  Status build(const MeshDistance& target, const Pose& objectFromHand, const GridBox& box,
+               SdfGrid& out, const CpuSdfOptions& options);
+
+  // Nodes the last successful build queried exactly (all of them without a band).
+  size_t lastExactNodes() const { return lastExactNodes_; }
 
  private:
   struct Pool;
+  Status buildFar(const MeshDistance& target, const Pose& objectFromHand, const GridBox& box,
+                  float band, SdfGrid& out);
   std::unique_ptr<Pool> pool_;
+  size_t lastExactNodes_ = 0;
 };
 
 }  // namespace sdfg

@@ -71,9 +71,16 @@ class SdfGrid {
   // Gradient of the trilinear interpolant at a hand-space point, in hand space (per metre).
   glm::vec3 gradient(const glm::vec3& pHand) const;
 
+  // 0: every value is the exact signed distance. > 0 (a far-field build, CpuSdfOptions): values
+  // of nodes closer to the surface than this (metres) are exact; the others may be lower bounds
+  // of the distance, with the exact sign, of magnitude at least this.
+  float exactBand() const { return exactBand_; }
+  void setExactBand(float band) { exactBand_ = band; }
+
  private:
   GridBox box_;
   std::vector<float> values_;
+  float exactBand_ = 0.0f;
 };
 
 }  // namespace sdfg

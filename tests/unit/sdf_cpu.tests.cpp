@@ -4,6 +4,7 @@
 #include <cmath>
 #include <ctime>
 #include <iostream>
+#include <limits>
 #include <random>
 
 #include "distance_test_meshes.h"
@@ -184,6 +185,216 @@ TEST_CASE("Timing of CPU grab-box builds on the armadillo", "[.][timing]") {
                           [](float v) { return std::isfinite(v); }));
         std::cout << "  " << n << "^3, " << threads << " thread(s): " << best << " ms wall, "
                   << bestCpu << " ms CPU (best of 3)\n";
+      }
+    }
+  }
+}
+
+namespace {
+
+struct FarFieldCounts {
+  size_t bounded = 0;  // nodes whose value differs from the exact builder's
+  size_t far = 0;      // nodes at least the band from the surface
+};
+
+// Builds `box` exactly and in the far-field mode and checks the mode's contract node by node:
+// closer than the band, the exact builder's value bit for bit; elsewhere the exact sign and
+// band <= |value| <= |exact|; along grid edges no larger a difference than the spacing (or than
+// the exact field's own, where a winding-number sign flips away from the surface).
+FarFieldCounts checkFarField(const MeshDistance& d, const Pose& objectFromHand, const GridBox& box,
+                             float band) {
+  CpuSdfBuilder builder(2);
+  SdfGrid exact, far;
+  REQUIRE(builder.build(d, objectFromHand, box, exact) == Status::ok);
+  CHECK(builder.lastExactNodes() == box.nodeCount());
+  CpuSdfOptions options;
+  options.exactBand = band;
+  REQUIRE(builder.build(d, objectFromHand, box, far, options) == Status::ok);
+  REQUIRE(far.values().size() == exact.values().size());
+  CHECK(exact.exactBand() == 0.0f);
+  CHECK(far.exactBand() == band);
+  FarFieldCounts counts;
+  size_t wrongNear = 0, wrongSign = 0, outOfRange = 0, steep = 0;
+  const glm::uvec3 n = box.resolution;
+  const glm::vec3 h = box.spacing() * (1.0f + 1e-4f);
+  for (uint32_t k = 0; k < n.z; ++k) {
+    for (uint32_t j = 0; j < n.y; ++j) {
+      for (uint32_t i = 0; i < n.x; ++i) {
+        const float e = exact.at(i, j, k), f = far.at(i, j, k);
+        counts.far += std::abs(e) >= band;
+        if (f != e) ++counts.bounded;
+        if (std::abs(e) < band) {
+          wrongNear += f != e;
+          continue;
+        }
+        wrongSign += (f < 0.0f) != (e < 0.0f);
+        outOfRange += !(std::abs(f) >= band && std::abs(f) <= std::abs(e));
+        const glm::uvec3 p(i, j, k);
+        for (int axis = 0; axis < 3; ++axis) {
+          if (p[axis] + 1 >= n[axis]) continue;
+          glm::uvec3 q = p;
+          ++q[axis];
+          const float fq = far.at(q.x, q.y, q.z), eq = exact.at(q.x, q.y, q.z);
+          steep += std::abs(f - fq) > std::max(h[axis], std::abs(e - eq) + 1e-6f);
+        }
+      }
+    }
+  }
+  CHECK(wrongNear == 0);
+  CHECK(wrongSign == 0);
+  CHECK(outOfRange == 0);
+  CHECK(steep == 0);
+  CHECK(builder.lastExactNodes() + counts.bounded <= box.nodeCount());
+  return counts;
+}
+
+// An icosphere with a cap of triangles removed: open, so signed by winding number.
+TriangleMesh openSphere() {
+  TriangleMesh m = icosphereMesh(0.05f, 3);
+  std::vector<uint32_t> kept;
+  for (size_t t = 0; t < m.triangleCount(); ++t) {
+    const glm::vec3 c = (m.positions[m.indices[3 * t]] + m.positions[m.indices[3 * t + 1]] +
+                         m.positions[m.indices[3 * t + 2]]) /
+                        3.0f;
+    if (c.z > 0.04f) continue;
+    kept.insert(kept.end(), m.indices.begin() + 3 * t, m.indices.begin() + 3 * t + 3);
+  }
+  m.indices = kept;
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("The far-field mode is exact within the band and a same-sign lower bound beyond",
+          "[sdf_cpu][far]") {
+  const Pose identity;
+  SECTION("a closed sphere (pseudo-normal sign), several boxes and bands") {
+    const auto d = makeDistance(icosphereMesh(0.05f, 3));
+    REQUIRE_FALSE(d->signsByWinding());
+    for (const glm::vec3 centre : {glm::vec3(0.03f, 0.0f, 0.02f), glm::vec3(0.0f, 0.06f, 0.0f),
+                                   glm::vec3(0.0f, 0.0f, 0.0f)}) {
+      const GridBox box = boxAt(handPointFor(centre), 16, 0.2133f);
+      for (const float spacings : {1.0f, 2.0f, 3.0f}) {
+        const FarFieldCounts c =
+            checkFarField(*d, kObjectFromHand, box, spacings * box.maxSpacing());
+        // Most nodes of such a box are far: the mode must skip some of them.
+        CHECK(c.bounded > 0);
+        CHECK(c.bounded <= c.far);
+      }
+    }
+  }
+  SECTION("an open sphere (winding-number sign), looking into the hole") {
+    const auto d = makeDistance(openSphere());
+    REQUIRE(d->signsByWinding());
+    const GridBox box = boxAt(handPointFor(glm::vec3(0.0f, 0.0f, 0.06f)), 16, 0.2133f);
+    const FarFieldCounts c = checkFarField(*d, kObjectFromHand, box, 2.0f * box.maxSpacing());
+    CHECK(c.bounded > 0);
+  }
+  SECTION("odd and uneven resolutions") {
+    const auto d = makeDistance(icosphereMesh(0.05f, 2));
+    GridBox box = boxAt(handPointFor(glm::vec3(0.02f, 0.01f, 0.0f)), 16, 0.2133f);
+    box.resolution = glm::uvec3(7, 16, 23);
+    checkFarField(*d, kObjectFromHand, box, 2.0f * box.maxSpacing());
+    box.resolution = glm::uvec3(2, 3, 5);
+    checkFarField(*d, identity, box, 0.01f);
+  }
+}
+
+TEST_CASE("The far-field mode holds its contract on the shared meshes", "[sdf_cpu][far][shared]") {
+  for (const char* name : {"stanford-armadillo-100k.obj", "stanford-dragon-100k.obj",
+                           "stanford-bunny.obj", "newell-teapot.obj"}) {
+    const TriangleMesh* mesh = normalizedSharedMesh(name);
+    if (mesh == nullptr) SDFG_SKIP("shared meshes absent");
+    INFO(name);
+    const auto d = makeDistance(*mesh);
+    // Boxes centred a few centimetres off vertices spread over the mesh, as a hand near it.
+    std::mt19937 rng(7);
+    size_t bounded = 0;
+    for (int b = 0; b < 3; ++b) {
+      const glm::vec3 v = mesh->positions[rng() % mesh->positions.size()];
+      const glm::vec3 centre = v + 0.04f * glm::normalize(v + glm::vec3(1e-3f));
+      const GridBox box = boxAt(handPointFor(centre), 16, 0.2133f);
+      bounded += checkFarField(*d, kObjectFromHand, box, 2.0f * box.maxSpacing()).bounded;
+    }
+    CHECK(bounded > 0);
+  }
+}
+
+TEST_CASE("The far-field mode gives the same grid with 1 and 2 threads", "[sdf_cpu][far]") {
+  const auto d = makeDistance(openSphere());
+  const GridBox box = boxAt(handPointFor(glm::vec3(0.0f, 0.02f, 0.05f)), 20, 0.2133f);
+  CpuSdfOptions options;
+  options.exactBand = 2.0f * box.maxSpacing();
+  CpuSdfBuilder one(1), two(2);
+  SdfGrid a, b;
+  REQUIRE(one.build(*d, kObjectFromHand, box, a, options) == Status::ok);
+  REQUIRE(two.build(*d, kObjectFromHand, box, b, options) == Status::ok);
+  CHECK(std::equal(a.values().begin(), a.values().end(), b.values().begin(), b.values().end()));
+  CHECK(one.lastExactNodes() == two.lastExactNodes());
+  CHECK(one.lastExactNodes() < box.nodeCount());
+}
+
+TEST_CASE("The far-field band is validated", "[sdf_cpu][far]") {
+  const auto d = makeDistance(icosphereMesh(0.05f, 2));
+  const GridBox box = boxAt(handPointFor(glm::vec3(0.0f)), 8);
+  CpuSdfBuilder builder(1);
+  SdfGrid grid;
+  CpuSdfOptions options;
+  for (const float bad :
+       {-0.01f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    options.exactBand = bad;
+    CHECK(builder.build(*d, kObjectFromHand, box, grid, options) == Status::invalid_argument);
+  }
+  SECTION("a zero band is the exact builder") {
+    options.exactBand = 0.0f;
+    SdfGrid exact;
+    REQUIRE(builder.build(*d, kObjectFromHand, box, grid, options) == Status::ok);
+    REQUIRE(builder.build(*d, kObjectFromHand, box, exact) == Status::ok);
+    CHECK(std::equal(grid.values().begin(), grid.values().end(), exact.values().begin(),
+                     exact.values().end()));
+    CHECK(grid.exactBand() == 0.0f);
+  }
+  SECTION("a bad box still fails") {
+    options.exactBand = 0.02f;
+    GridBox bad = box;
+    bad.resolution = glm::uvec3(1);
+    CHECK(builder.build(*d, kObjectFromHand, bad, grid, options) == Status::invalid_argument);
+  }
+}
+
+TEST_CASE("Timing of the far-field mode against exact builds", "[.][timing][far]") {
+  using Clock = std::chrono::steady_clock;
+  for (const char* name :
+       {"stanford-armadillo-100k.obj", "stanford-dragon-100k.obj", "stanford-bunny.obj"}) {
+    const TriangleMesh* m = normalizedSharedMesh(name);
+    if (m == nullptr) SDFG_SKIP("shared meshes missing");
+    const auto d = makeDistance(*m);
+    for (unsigned threads : {1u, 2u}) {
+      CpuSdfBuilder builder(threads);
+      std::mt19937 rng(3);
+      std::vector<GridBox> boxes;
+      for (int b = 0; b < 20; ++b) {
+        const glm::vec3 v = m->positions[rng() % m->positions.size()];
+        GridBox box = GridBox::referenceDefault();
+        box.handFromBox.position = v + 0.04f * glm::normalize(v + glm::vec3(1e-3f));
+        boxes.push_back(box);
+      }
+      for (const float spacings : {0.0f, 1.0f, 2.0f, 3.0f}) {
+        CpuSdfOptions options;
+        options.exactBand = spacings * boxes[0].maxSpacing();
+        std::vector<double> ms;
+        size_t exact = 0;
+        SdfGrid grid;
+        for (const GridBox& box : boxes) {
+          const auto s = Clock::now();
+          REQUIRE(builder.build(*d, Pose{}, box, grid, options) == Status::ok);
+          ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - s).count());
+          exact += builder.lastExactNodes();
+        }
+        std::sort(ms.begin(), ms.end());
+        std::cout << name << " band " << spacings << " h: median " << ms[ms.size() / 2] << " ms ("
+                  << threads << " threads), exact nodes " << 100.0 * double(exact) / (20.0 * 4096.0)
+                  << " %\n";
       }
     }
   }

@@ -67,6 +67,9 @@ const char* kUsage =
     "  --sdf-backend LIST comma-separated SDF builders: cpu, vulkan (default cpu); each SDF\n"
     "                     method gets one row per backend, solving on that backend's field.\n"
     "                     vulkan: a device of its own (VK_ICD_FILENAMES picks the driver)\n"
+    "  --sdf-far-band M   cpu builder far-field mode: nodes at least M metres from the surface\n"
+    "                     may hold certified lower bounds (CpuSdfOptions::exactBand; default 0,\n"
+    "                     exact everywhere)\n"
     "  --thin-plate-set   only the embedded thin plate, graded on the placements where\n"
     "                     \"paper\" (added if missing; --da must be 0.1) passes through it\n"
     "  --json FILE        write the results as JSON\n"
@@ -95,6 +98,7 @@ struct Options {
   float da = 0.1f;
   int resolution = 16;
   unsigned threads = 0;
+  float sdfFarBand = 0.0f;  // CpuSdfOptions::exactBand of the cpu builder
   std::vector<std::string> sdfBackends = {tools::kCpuBackend};
   bool sdfBackendsGiven = false;  // else --scaling compares cpu and vulkan
   std::string json;
@@ -215,6 +219,14 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
       if (auto e = needValue(v)) return e;
       if (!parseInt(v, 0, 1024, n)) return UsageError{"--threads: \"" + v + "\" is not 0..1024"};
       o.threads = unsigned(n);
+    } else if (arg == "--sdf-far-band") {
+      if (auto e = needValue(v)) return e;
+      char* end = nullptr;
+      const float x = std::strtof(v.c_str(), &end);
+      if (v.empty() || *end != '\0' || !std::isfinite(x) || !(x >= 0.0f)) {
+        return UsageError{"--sdf-far-band: \"" + v + "\" is not a distance >= 0 in metres"};
+      }
+      o.sdfFarBand = x;
     } else if (arg == "--sdf-backend") {
       if (auto e =
               needList({tools::kCpuBackend, tools::kVulkanBackend}, "backend", o.sdfBackends)) {
@@ -868,6 +880,7 @@ int main(int argc, char** argv) {
   bool backendMissing = false;
   tools::TimedBuilderOptions builderOptions;
   builderOptions.cpuThreads = threads;
+  builderOptions.cpuExactBand = o.sdfFarBand;
   for (const std::string& backend : o.sdfBackends) {
     auto b = tools::makeTimedBuilder(backend, builderOptions);
     if (!b) {

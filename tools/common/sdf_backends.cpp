@@ -18,9 +18,11 @@ namespace {
 
 class CpuTimedBuilder final : public TimedSdfBuilder {
  public:
-  explicit CpuTimedBuilder(unsigned threads)
+  CpuTimedBuilder(unsigned threads, float exactBand)
       : threads_(threads ? threads : std::max(1u, std::thread::hardware_concurrency())),
-        builder_(threads_) {}
+        builder_(threads_) {
+    options_.exactBand = exactBand;
+  }
   std::string name() const override { return kCpuBackend; }
   std::string device() const override { return std::to_string(threads_) + " threads"; }
   Status prepare(const TriangleMesh&, const MeshDistance& distance) override {
@@ -29,7 +31,7 @@ class CpuTimedBuilder final : public TimedSdfBuilder {
   }
   Status build(const Pose& objectFromHand, const GridBox& box, SdfGrid& out) override {
     if (!distance_) return Status::invalid_argument;
-    return builder_.build(*distance_, objectFromHand, box, out);
+    return builder_.build(*distance_, objectFromHand, box, out, options_);
   }
   Status buildAndSample(const Pose& objectFromHand, const GridBox& box,
                         std::span<const glm::vec3> points, std::vector<float>& samples) override {
@@ -42,6 +44,7 @@ class CpuTimedBuilder final : public TimedSdfBuilder {
  private:
   unsigned threads_;
   CpuSdfBuilder builder_;
+  CpuSdfOptions options_;
   const MeshDistance* distance_ = nullptr;
   SdfGrid grid_;
 };
@@ -105,7 +108,8 @@ std::string backendTitle(const std::string& backend) {
 Result<std::unique_ptr<TimedSdfBuilder>> makeTimedBuilder(const std::string& backend,
                                                           const TimedBuilderOptions& options) {
   if (backend == kCpuBackend) {
-    return std::unique_ptr<TimedSdfBuilder>(new CpuTimedBuilder(options.cpuThreads));
+    return std::unique_ptr<TimedSdfBuilder>(
+        new CpuTimedBuilder(options.cpuThreads, options.cpuExactBand));
   }
   if (backend != kVulkanBackend) {
     return makeError(Status::invalid_argument, "unknown SDF backend \"" + backend + "\"");

@@ -57,6 +57,7 @@ class TimedSdfBuilder {
 
 struct TimedBuilderOptions {
   unsigned cpuThreads = 0;     // CpuSdfBuilder threads (0: one per hardware thread)
+  float cpuExactBand = 0.0f;   // CpuSdfOptions::exactBand, metres (0: exact at every node)
   bool vulkanProfile = false;  // GPU timestamps per pass (VkSdfOptions::profile)
   uint32_t vulkanWorkGroupSize = 64;
 };

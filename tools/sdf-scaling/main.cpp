@@ -5,6 +5,7 @@
 //
 // --only torus|meshes keeps one group of rows. --wg sets the compute work-group size (default 64).
 // --profile adds the Vulkan pass times (GPU timestamps) of the last run to each row.
+// --far-band M runs the CPU builder in its far-field mode (CpuSdfOptions::exactBand = M metres).
 //
 // Objects (tools/common/sdf_backends.h, the same as autograsp-bench --scaling): a procedural torus
 // tessellated to 5k .. 400k triangles (the same surface at every count), then the shared test
@@ -57,6 +58,8 @@ int main(int argc, char** argv) {
       const std::string which = argv[++i];
       torusRows = which == "torus";
       meshRows = which == "meshes";
+    } else if (a == "--far-band" && i + 1 < argc) {
+      builderOptions.cpuExactBand = std::strtof(argv[++i], nullptr);
     } else if (a == "--profile") {
       builderOptions.vulkanProfile = true;
     } else if (a == "--quick") {
@@ -69,7 +72,7 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: %s [--meshes DIR] [--runs N] [--res 16,32,64] [--quick] [--profile] "
-                   "[--wg N] [--only torus|meshes]\n",
+                   "[--wg N] [--only torus|meshes] [--far-band M]\n",
                    argv[0]);
       return 2;
     }
@@ -105,8 +108,9 @@ int main(int argc, char** argv) {
   const std::vector<glm::vec3> points = tools::frameSamplePoints();
   std::printf("# autograsp-sdf-scaling: grab-box SDF build + 50 samples, median of %d runs\n",
               runs);
-  std::printf("# vulkan device: %s; cpu: %s\n", haveVulkan ? builders[1]->device().c_str() : "none",
-              builders[0]->device().c_str());
+  std::printf("# vulkan device: %s; cpu: %s, far-field band %g m\n",
+              haveVulkan ? builders[1]->device().c_str() : "none", builders[0]->device().c_str(),
+              double(builderOptions.cpuExactBand));
   std::printf("| object | triangles | resolution | cpu ms | vulkan ms | cpu/vulkan |\n");
   std::printf("|---|---:|---:|---:|---:|---:|\n");
   std::fflush(stdout);

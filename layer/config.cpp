@@ -29,9 +29,9 @@ bool parseBool(const std::string& text, bool& out) {
   return false;
 }
 
-const char* const kKeys[] = {"log_level",  "solver",      "grab_threshold", "release_ratio",
-                             "resolution", "curl_step",   "exact_check",    "synthesis",
-                             "gpu",        "extra_queue", "test_gpu_fault"};
+const char* const kKeys[] = {"log_level",  "solver",    "grab_threshold", "release_ratio",
+                             "resolution", "curl_step", "exact_check",    "sdf_far_band",
+                             "synthesis",  "gpu",       "extra_queue",    "test_gpu_fault"};
 
 }  // namespace
 
@@ -54,6 +54,8 @@ bool applyConfigValue(Config& config, const std::string& key, const std::string&
     c.resolution = unsigned(r);
   } else if (key == "curl_step") {
     ok = parseFloat(value, 1e-5f, 1.0f, c.curlStep);
+  } else if (key == "sdf_far_band") {
+    ok = parseFloat(value, 0.0f, 64.0f, c.sdfFarBand);
   } else if (key == "exact_check") {
     ok = parseBool(value, c.exactCheck);
   } else if (key == "synthesis") {

@@ -18,7 +18,11 @@ struct Config {
   unsigned resolution = 16;            // resolution: grid nodes per axis, 2..128
   float curlStep = 0.02f;              // curl_step: solver step along each finger curve
   bool exactCheck = true;              // exact_check: "ours" checks stops on the exact mesh
-  bool synthesis = true;               // synthesis: offer XR_EXT_hand_tracking from controllers
+  // sdf_far_band: CPU builds keep nodes within this many node spacings (of the configured box)
+  // of the surface exact and may give farther ones a certified lower bound (CpuSdfOptions); 0:
+  // every node exact.
+  float sdfFarBand = 2.0f;
+  bool synthesis = true;  // synthesis: offer XR_EXT_hand_tracking from controllers
   // gpu: where Vulkan sessions build the SDFs of array targets. auto: on the app's device unless
   // it is a CPU implementation (lavapipe, SwiftShader), where the CPU builder is faster and the
   // two would compete for the same cores; on: on the device; off: on the CPU. Targets in the app's

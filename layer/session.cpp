@@ -1,5 +1,7 @@
 // Sessions and what the layer tracks on them: system properties (hand tracking it provides),
 // session create/destroy, the predicted display time, and the app's spaces.
+#include <algorithm>
+
 #include "intercepts.h"
 #include "log.h"
 #include "state.h"
@@ -75,7 +77,13 @@ XrResult XRAPI_CALL SdfgXrCreateSession(XrInstance instance, const XrSessionCrea
   // the path of every other session.
   std::unique_ptr<DeferredSdfBackend> gpu;
   if (s->vulkan && state->appAutoGrasp) gpu = makeVulkanBackend(*s);
-  s->grasp = std::make_unique<GraspSession>(makeCpuSdfBackend(2), std::move(gpu));
+  // The band is fixed in metres from the configured box: a finer grid chosen later through
+  // xrSetGraspOptionsSDFG keeps it, so its nodes are exact over more spacings (slower, as safe).
+  CpuSdfOptions cpuOptions;
+  const glm::vec3 spacing = s->settings.box.spacing();
+  cpuOptions.exactBand =
+      state->config.sdfFarBand * std::max(spacing.x, std::max(spacing.y, spacing.z));
+  s->grasp = std::make_unique<GraspSession>(makeCpuSdfBackend(2, cpuOptions), std::move(gpu));
   s->grasp->setDeferredForMeshTargets(s->gpuForArrayTargets);
   if (Status st = s->grasp->configure(s->settings); st != Status::ok) {
     SDFG_LOG_WARN(cmd, "configured solver '%s' is not usable (%s); using 'paper'",

@@ -39,6 +39,12 @@ constexpr int kMaxRefineIterations = 40;
 // many doubling opening steps when every pose tried was inside.
 constexpr int kMaxExactIterations = 8;
 constexpr int kMaxExactBackoff = 6;
+// A candidate not sampled yet is taken to be no nearer than its field clearance minus this (the
+// 16^3 field's error is within it on all but the sharpest parts), so when the closest one's
+// exact clearance is below that bound the others are not sampled: most stops then take one
+// sample per pose instead of one per candidate. A sphere whose field clearance is wrong by more
+// can only be missed while another, nearer one is touching.
+constexpr float kFieldTrust = 0.002f;  // metres
 // Kinematics rebuilt from fingerPose() must match it this closely, else solve() asks the model.
 constexpr float kKinematicsTolerance = 2e-5f;  // metres
 
@@ -607,6 +613,9 @@ struct OursSolver::ExactContext {
   const FastSampler* sample = nullptr;
   const glm::mat3* toBox = nullptr;
   glm::vec3 toBoxOffset{0.0f};
+  // Per sphere of the finger being solved: the source's closest feature at its last sample
+  // (ExactSample::feature), handed back as the next search's hint.
+  std::array<uint32_t, OursSolver::kMaxSpheres>* hints = nullptr;
 };
 
 namespace {
@@ -659,7 +668,8 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
   // Each candidate's last exact clearance (or the lower bound a bounded search gave) and curl:
   // the centre's distance is 1-Lipschitz and moves at most speed * |da|, so a candidate whose
   // bound stays kLazyMargin above the smallest one cannot be the closest and is not sampled.
-  // `fresh`: not sampled yet (searched over the whole band).
+  // `fresh`: not sampled yet (searched over the whole band; its lower bound is its field
+  // clearance minus kFieldTrust).
   std::array<float, kMaxSpheres> lastG{}, lastA{};
   std::array<bool, kMaxSpheres> fresh{};
   // Candidates are chosen on the field at every pose tried: a sphere of the frozen bones that
@@ -683,7 +693,7 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
         isCand[i] = true;
         fresh[count] = true;
         lastA[count] = v;
-        lastG[count] = -kExactBand;
+        lastG[count] = g - kFieldTrust;
         cand[count++] = i;
         maxSpeed = std::max(maxSpeed, speed[i]);
       } else if (speed[i] > 0.0f) {
@@ -706,10 +716,13 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
     const float upper = fresh[k] ? kExactBand : lastG[k] + speed[cand[k]] * std::abs(v - lastA[k]);
     fresh[k] = false;
     bounds[0] = radius + std::clamp(upper + 0.0005f, 0.0005f, kExactBand);
+    uint32_t& hint = (*cx.hints)[size_t(cand[k])];
+    found[0].feature = hint;
     cx.source->sample(std::span(points.data(), 1), std::span(bounds.data(), 1),
                       std::span(found.data(), 1));
     ++samples;
     lastA[k] = v;
+    if (found[0].feature != std::numeric_limits<uint32_t>::max()) hint = found[0].feature;
     if (!std::isfinite(found[0].distance)) {  // clear by more than the search distance
       lastG[k] = bounds[0] - radius;
       return;
@@ -739,12 +752,12 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
   // The smallest clearance over the candidates: sampled in order of their lower bounds, until
   // the smallest found is below every bound left (those cannot be nearer, nor inside when it
   // is not). Returns how many were sampled.
-  auto measureOnce = [&](float v, ExactEval& r) {
+  auto measureOnce = [&](float v, ExactEval& r, bool forceFresh) {
     std::array<float, kMaxSpheres> lower{};
     std::array<int, kMaxSpheres> order{};
     for (int k = 0; k < count; ++k) {
-      lower[k] = fresh[k] ? -std::numeric_limits<float>::infinity()
-                          : lastG[k] - speed[cand[k]] * std::abs(v - lastA[k]);
+      lower[k] = fresh[k] && forceFresh ? -std::numeric_limits<float>::infinity()
+                                        : lastG[k] - speed[cand[k]] * std::abs(v - lastA[k]);
       int pos = k;
       while (pos > 0 && lower[order[pos - 1]] > lower[k]) {
         order[pos] = order[pos - 1];
@@ -768,9 +781,9 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
     setCurl(v);
     jointPositions(f, curls, hand);
     select(v);
-    if (measureOnce(v, r) < count && r.arg < 0) {
+    if (measureOnce(v, r, false) < count && r.arg < 0) {
       for (int k = 0; k < count; ++k) fresh[k] = true;
-      measureOnce(v, r);
+      measureOnce(v, r, true);
     }
     if (r.arg < 0) {
       r.g = kExactBand;
@@ -894,10 +907,13 @@ Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {
   using Clock = std::chrono::steady_clock;
   Clock::duration checkTime{0};
 
+  std::array<uint32_t, kMaxSpheres> hints{};
+  cx.hints = &hints;
   for (int f = 0; f < kFingerCount; ++f) {
     const FingerRig& fr = fingers_[f];
     const int n = fr.joints;
     FingerState& state = out.fingers[f];
+    hints.fill(std::numeric_limits<uint32_t>::max());
     JointCurls curls{0.0f, 0.0f, 0.0f, 0.0f};
     int firstFree = 0;
     float a = 0.0f;

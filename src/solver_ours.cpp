@@ -44,7 +44,7 @@ constexpr int kMaxExactBackoff = 6;
 // exact clearance is below that bound the others are not sampled: most stops then take one
 // sample per pose instead of one per candidate. A sphere whose field clearance is wrong by more
 // can only be missed while another, nearer one is touching.
-constexpr float kFieldTrust = 0.002f;  // metres
+constexpr float kFieldTrust = 0.001f;  // metres
 // Kinematics rebuilt from fingerPose() must match it this closely, else solve() asks the model.
 constexpr float kKinematicsTolerance = 2e-5f;  // metres
 

@@ -45,6 +45,9 @@ constexpr int kMaxExactBackoff = 6;
 // sample per pose instead of one per candidate. A sphere whose field clearance is wrong by more
 // can only be missed while another, nearer one is touching.
 constexpr float kFieldTrust = 0.001f;  // metres
+// A first step on the field's slope (no secant yet) moves no sphere more than its clearance plus
+// this, so none can pass through a thin part on a wrong slope.
+constexpr float kFieldSlopeReach = 0.002f;  // metres
 // Kinematics rebuilt from fingerPose() must match it this closely, else solve() asks the model.
 constexpr float kKinematicsTolerance = 2e-5f;  // metres
 
@@ -791,6 +794,28 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
     }
   };
 
+  // d(clearance)/d(curl) of sphere i on the curvature-corrected field, by a one-sided
+  // difference towards opening. Leaves the joint positions at curl v.
+  auto fieldSlope = [&](int i, float v) {
+    const Sphere& s = fr.spheres[i];
+    auto clearance = [&](float w) {
+      setCurl(w);
+      jointPositions(f, curls, hand);
+      const glm::vec3 uvw = *cx.toBox * centreOf(s) + cx.toBoxOffset;
+      const float value = (*cx.sample)(uvw);
+      return std::min(value, cx.sample->corrected(uvw, value));
+    };
+    const float dv = std::min(v, 0.01f);
+    if (!(dv > 0.0f)) {
+      setCurl(v);
+      jointPositions(f, curls, hand);
+      return 0.0f;
+    }
+    const float g0 = clearance(v - dv);
+    const float g1 = clearance(v);
+    return (g1 - g0) / dv;
+  };
+
   ExactEval cur;
   measure(a, cur);
   if (cur.arg < 0 && touching < 0) {  // nothing near: the field's pose stands
@@ -818,12 +843,18 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
     }
     if ((cur.g >= 0.0f && cur.g <= tol) || it >= kMaxExactIterations) break;
     const float argSpeed = cur.arg >= 0 ? std::max(speed[cur.arg], 1e-4f) : maxSpeed;
-    // A secant only through two samples of the same sphere.
-    const float slope =
-        havePrev && argPrev == cur.arg && aCur != aPrev ? (cur.g - gPrev) / (aCur - aPrev) : 0.0f;
+    // A secant only through two samples of the same sphere. Without one, the field's slope of
+    // that sphere's clearance along the curl (the field's values are off by up to millimetres
+    // near curved parts, its slope much less) replaces the conservative first step, which
+    // saves a sample per stop; closing on it is limited to kFieldSlopeReach of motion.
+    const bool secant = havePrev && argPrev == cur.arg && aCur != aPrev;
+    float slope = secant ? (cur.g - gPrev) / (aCur - aPrev) : 0.0f;
+    if (!secant && cur.arg >= 0) slope = fieldSlope(cur.arg, aCur);
     float next;
     if (slope < 0.0f) {
       next = aCur + (0.5f * tol - cur.g) / slope;
+      if (!secant)
+        next = std::min(next, aCur + (std::max(cur.g, 0.0f) + kFieldSlopeReach) / maxSpeed);
     } else if (cur.g > 0.0f) {
       // The closest sphere does not come nearer as the group closes (it slides along
       // the surface): advance conservatively, no checked sphere moving more than its

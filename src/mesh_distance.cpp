@@ -445,32 +445,45 @@ Status MeshDistance::signedDistances(std::span<const glm::vec3> points,
 
 float MeshDistance::localSignedDistanceWithin(const glm::vec3& p, float maxDistance,
                                               glm::vec3* closestPoint) const {
+  return localSignedDistanceNear(p, maxDistance, std::numeric_limits<uint32_t>::max(),
+                                 closestPoint);
+}
+
+float MeshDistance::localSignedDistanceNear(const glm::vec3& p, float maxDistance,
+                                            uint32_t hintTriangle, glm::vec3* closestPoint,
+                                            uint32_t* closestTriangle) const {
   const Impl& m = *impl_;
   if (!(maxDistance >= 0.0f)) return std::numeric_limits<float>::infinity();
-  TriangleBvh::Hit seed;
-  seed.distanceSquared = double(maxDistance) * double(maxDistance);
-  const TriangleBvh::Hit hit = m.bvh.closest(p, seed);
-  if (!hit.found()) return std::numeric_limits<float>::infinity();
-  if (closestPoint != nullptr) *closestPoint = glm::vec3(hit.point);
-  const uint32_t* tri = &m.mesh.indices[3 * hit.triangle];
+  std::array<TriangleBvh::Hit, 1> hit;
+  hit[0].distanceSquared = double(maxDistance) * double(maxDistance);
+  if (hintTriangle < m.mesh.triangleCount()) {
+    const TriangleBvh::Hit h = m.bvh.evaluate(p, hintTriangle);
+    if (h.distanceSquared < hit[0].distanceSquared) hit[0] = h;
+  }
+  // (closestPacket() with one lane measured slower here: its filter pays off over groups.)
+  hit[0] = m.bvh.closest(p, hit[0]);
+  if (!hit[0].found()) return std::numeric_limits<float>::infinity();
+  if (closestPoint != nullptr) *closestPoint = glm::vec3(hit[0].point);
+  if (closestTriangle != nullptr) *closestTriangle = hit[0].triangle;
+  const uint32_t* tri = &m.mesh.indices[3 * hit[0].triangle];
   glm::dvec3 n(0.0);
-  switch (hit.feature) {
+  switch (hit[0].feature) {
     case TriangleFeature::face:
-      n = m.faceNormal[hit.triangle];
+      n = m.faceNormal[hit[0].triangle];
       break;
     case TriangleFeature::edge0:
     case TriangleFeature::edge1:
     case TriangleFeature::edge2:
-      n = m.edgeNormal[m.triangleEdge[3 * hit.triangle + (int(hit.feature) - 1)]];
+      n = m.edgeNormal[m.triangleEdge[3 * hit[0].triangle + (int(hit[0].feature) - 1)]];
       break;
     case TriangleFeature::vertex0:
     case TriangleFeature::vertex1:
     case TriangleFeature::vertex2:
-      n = m.vertexNormal[tri[int(hit.feature) - 4]];
+      n = m.vertexNormal[tri[int(hit[0].feature) - 4]];
       break;
   }
-  const float d = float(std::sqrt(hit.distanceSquared));
-  return glm::dot(glm::dvec3(p) - hit.point, n) < 0.0 ? -d : d;
+  const float d = float(std::sqrt(hit[0].distanceSquared));
+  return glm::dot(glm::dvec3(p) - hit[0].point, n) < 0.0 ? -d : d;
 }
 
 float MeshDistance::windingNumber(const glm::vec3& p) const {

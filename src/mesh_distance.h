@@ -54,6 +54,15 @@ class MeshDistance {
   // pointer is not null.
   float localSignedDistanceWithin(const glm::vec3& p, float maxDistance,
                                   glm::vec3* closestPoint = nullptr) const;
+  // localSignedDistanceWithin() seeded with a triangle likely to be near `p` (the previous
+  // closest triangle of a point that moved a little): when it is within `maxDistance` its exact
+  // distance bounds the search from the start, so fewer subtrees are walked.
+  // Same result as localSignedDistanceWithin() whatever the hint (a hint out of range or
+  // farther than `maxDistance` is ignored). Writes the closest triangle to *closestTriangle when
+  // one was found and the pointer is not null.
+  float localSignedDistanceNear(const glm::vec3& p, float maxDistance, uint32_t hintTriangle,
+                                glm::vec3* closestPoint = nullptr,
+                                uint32_t* closestTriangle = nullptr) const;
   // signedDistance(p) seeded with a triangle likely to be near `p` (in a sweep over grid nodes,
   // the previous node's closest triangle): its exact distance bounds the search, so far less of
   // the hierarchy is visited. Same distance as signedDistance(p) whatever the hint (the sign too,

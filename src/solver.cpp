@@ -90,9 +90,10 @@ void MeshExactSource::sample(std::span<const glm::vec3> handPoints,
   for (size_t i = 0; i < handPoints.size(); ++i) {
     glm::vec3 closest(0.0f);
     ExactSample& o = out[i];
+    const uint32_t hint = o.feature;
     o = ExactSample{};
-    o.distance = mesh_->localSignedDistanceWithin(objectFromHand_.transformPoint(handPoints[i]),
-                                                  maxDistances[i], &closest);
+    o.distance = mesh_->localSignedDistanceNear(objectFromHand_.transformPoint(handPoints[i]),
+                                                maxDistances[i], hint, &closest, &o.feature);
     if (std::isfinite(o.distance)) o.closest = handFromObject_.transformPoint(closest);
   }
 }

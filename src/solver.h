@@ -8,6 +8,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -62,6 +63,11 @@ struct ExactSample {
   // (then the side is unknown and `closest` is not set).
   float distance = std::numeric_limits<float>::infinity();
   glm::vec3 closest{0.0f};  // closest surface point, in the frame of the query point
+  // Source-specific id of the closest feature (MeshExactSource: the triangle), or max() when
+  // none was found. On entry to sample() it is a hint: the id an earlier sample of a point near
+  // this one returned (max(): none), which may make the search cheaper; it never changes the
+  // result.
+  uint32_t feature = std::numeric_limits<uint32_t>::max();
 };
 
 // Exact distance to the target at a few points, for strategies that check the stops they found
@@ -73,7 +79,8 @@ class ExactDistanceSource {
   virtual ~ExactDistanceSource() = default;
   // For each i: out[i] is the exact sample of handPoints[i] (scene hand frame) searched within
   // maxDistances[i] metres (a small bound keeps the search cheap). The three spans must have the
-  // same size; the caller owns them. Must be safe to call from several threads at once.
+  // same size; the caller owns them. out[i].feature on entry is a hint (see ExactSample). Must be
+  // safe to call from several threads at once.
   virtual void sample(std::span<const glm::vec3> handPoints, std::span<const float> maxDistances,
                       std::span<ExactSample> out) const = 0;
 };

@@ -39,6 +39,15 @@ constexpr int kMaxRefineIterations = 40;
 // many doubling opening steps when every pose tried was inside.
 constexpr int kMaxExactIterations = 8;
 constexpr int kMaxExactBackoff = 6;
+// A candidate not sampled yet is taken to be no nearer than its field clearance minus this (the
+// 16^3 field's error is within it on all but the sharpest parts), so when the closest one's
+// exact clearance is below that bound the others are not sampled: most stops then take one
+// sample per pose instead of one per candidate. A sphere whose field clearance is wrong by more
+// can only be missed while another, nearer one is touching.
+constexpr float kFieldTrust = 0.001f;  // metres
+// A first step on the field's slope (no secant yet) moves no sphere more than its clearance plus
+// this, so none can pass through a thin part on a wrong slope.
+constexpr float kFieldSlopeReach = 0.002f;  // metres
 // Kinematics rebuilt from fingerPose() must match it this closely, else solve() asks the model.
 constexpr float kKinematicsTolerance = 2e-5f;  // metres
 
@@ -607,6 +616,9 @@ struct OursSolver::ExactContext {
   const FastSampler* sample = nullptr;
   const glm::mat3* toBox = nullptr;
   glm::vec3 toBoxOffset{0.0f};
+  // Per sphere of the finger being solved: the source's closest feature at its last sample
+  // (ExactSample::feature), handed back as the next search's hint.
+  std::array<uint32_t, OursSolver::kMaxSpheres>* hints = nullptr;
 };
 
 namespace {
@@ -659,7 +671,8 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
   // Each candidate's last exact clearance (or the lower bound a bounded search gave) and curl:
   // the centre's distance is 1-Lipschitz and moves at most speed * |da|, so a candidate whose
   // bound stays kLazyMargin above the smallest one cannot be the closest and is not sampled.
-  // `fresh`: not sampled yet (searched over the whole band).
+  // `fresh`: not sampled yet (searched over the whole band; its lower bound is its field
+  // clearance minus kFieldTrust).
   std::array<float, kMaxSpheres> lastG{}, lastA{};
   std::array<bool, kMaxSpheres> fresh{};
   // Candidates are chosen on the field at every pose tried: a sphere of the frozen bones that
@@ -683,7 +696,7 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
         isCand[i] = true;
         fresh[count] = true;
         lastA[count] = v;
-        lastG[count] = -kExactBand;
+        lastG[count] = g - kFieldTrust;
         cand[count++] = i;
         maxSpeed = std::max(maxSpeed, speed[i]);
       } else if (speed[i] > 0.0f) {
@@ -706,10 +719,13 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
     const float upper = fresh[k] ? kExactBand : lastG[k] + speed[cand[k]] * std::abs(v - lastA[k]);
     fresh[k] = false;
     bounds[0] = radius + std::clamp(upper + 0.0005f, 0.0005f, kExactBand);
+    uint32_t& hint = (*cx.hints)[size_t(cand[k])];
+    found[0].feature = hint;
     cx.source->sample(std::span(points.data(), 1), std::span(bounds.data(), 1),
                       std::span(found.data(), 1));
     ++samples;
     lastA[k] = v;
+    if (found[0].feature != std::numeric_limits<uint32_t>::max()) hint = found[0].feature;
     if (!std::isfinite(found[0].distance)) {  // clear by more than the search distance
       lastG[k] = bounds[0] - radius;
       return;
@@ -739,12 +755,12 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
   // The smallest clearance over the candidates: sampled in order of their lower bounds, until
   // the smallest found is below every bound left (those cannot be nearer, nor inside when it
   // is not). Returns how many were sampled.
-  auto measureOnce = [&](float v, ExactEval& r) {
+  auto measureOnce = [&](float v, ExactEval& r, bool forceFresh) {
     std::array<float, kMaxSpheres> lower{};
     std::array<int, kMaxSpheres> order{};
     for (int k = 0; k < count; ++k) {
-      lower[k] = fresh[k] ? -std::numeric_limits<float>::infinity()
-                          : lastG[k] - speed[cand[k]] * std::abs(v - lastA[k]);
+      lower[k] = fresh[k] && forceFresh ? -std::numeric_limits<float>::infinity()
+                                        : lastG[k] - speed[cand[k]] * std::abs(v - lastA[k]);
       int pos = k;
       while (pos > 0 && lower[order[pos - 1]] > lower[k]) {
         order[pos] = order[pos - 1];
@@ -768,14 +784,36 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
     setCurl(v);
     jointPositions(f, curls, hand);
     select(v);
-    if (measureOnce(v, r) < count && r.arg < 0) {
+    if (measureOnce(v, r, false) < count && r.arg < 0) {
       for (int k = 0; k < count; ++k) fresh[k] = true;
-      measureOnce(v, r);
+      measureOnce(v, r, true);
     }
     if (r.arg < 0) {
       r.g = kExactBand;
       for (int k = 0; k < count; ++k) r.g = std::min(r.g, lastG[k]);
     }
+  };
+
+  // d(clearance)/d(curl) of sphere i on the curvature-corrected field, by a one-sided
+  // difference towards opening. Leaves the joint positions at curl v.
+  auto fieldSlope = [&](int i, float v) {
+    const Sphere& s = fr.spheres[i];
+    auto clearance = [&](float w) {
+      setCurl(w);
+      jointPositions(f, curls, hand);
+      const glm::vec3 uvw = *cx.toBox * centreOf(s) + cx.toBoxOffset;
+      const float value = (*cx.sample)(uvw);
+      return std::min(value, cx.sample->corrected(uvw, value));
+    };
+    const float dv = std::min(v, 0.01f);
+    if (!(dv > 0.0f)) {
+      setCurl(v);
+      jointPositions(f, curls, hand);
+      return 0.0f;
+    }
+    const float g0 = clearance(v - dv);
+    const float g1 = clearance(v);
+    return (g1 - g0) / dv;
   };
 
   ExactEval cur;
@@ -805,12 +843,18 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
     }
     if ((cur.g >= 0.0f && cur.g <= tol) || it >= kMaxExactIterations) break;
     const float argSpeed = cur.arg >= 0 ? std::max(speed[cur.arg], 1e-4f) : maxSpeed;
-    // A secant only through two samples of the same sphere.
-    const float slope =
-        havePrev && argPrev == cur.arg && aCur != aPrev ? (cur.g - gPrev) / (aCur - aPrev) : 0.0f;
+    // A secant only through two samples of the same sphere. Without one, the field's slope of
+    // that sphere's clearance along the curl (the field's values are off by up to millimetres
+    // near curved parts, its slope much less) replaces the conservative first step, which
+    // saves a sample per stop; closing on it is limited to kFieldSlopeReach of motion.
+    const bool secant = havePrev && argPrev == cur.arg && aCur != aPrev;
+    float slope = secant ? (cur.g - gPrev) / (aCur - aPrev) : 0.0f;
+    if (!secant && cur.arg >= 0) slope = fieldSlope(cur.arg, aCur);
     float next;
     if (slope < 0.0f) {
       next = aCur + (0.5f * tol - cur.g) / slope;
+      if (!secant)
+        next = std::min(next, aCur + (std::max(cur.g, 0.0f) + kFieldSlopeReach) / maxSpeed);
     } else if (cur.g > 0.0f) {
       // The closest sphere does not come nearer as the group closes (it slides along
       // the surface): advance conservatively, no checked sphere moving more than its
@@ -894,10 +938,13 @@ Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {
   using Clock = std::chrono::steady_clock;
   Clock::duration checkTime{0};
 
+  std::array<uint32_t, kMaxSpheres> hints{};
+  cx.hints = &hints;
   for (int f = 0; f < kFingerCount; ++f) {
     const FingerRig& fr = fingers_[f];
     const int n = fr.joints;
     FingerState& state = out.fingers[f];
+    hints.fill(std::numeric_limits<uint32_t>::max());
     JointCurls curls{0.0f, 0.0f, 0.0f, 0.0f};
     int firstFree = 0;
     float a = 0.0f;

@@ -19,7 +19,10 @@
 //   exactly (bounded searches), their clearance measured against their own capsule, and the
 //   group's curl corrected by secant steps on that exact clearance until the closest one is
 //   within kContactTolerance of touching and none is inside (opening further if needed). The
-//   field's own polish is skipped then; without a source nothing changes.
+//   field's own polish is skipped then; without a source nothing changes. A candidate is not
+//   sampled while its field clearance minus kFieldTrust (solver_ours.cpp) cannot beat the
+//   closest one found, the first correction follows the field's slope, and each search is
+//   seeded with the sphere's last closest feature (ExactSample::feature).
 // - Approach (optional, SolverOptions::approach): approachPose() follows the field's gradient
 //   from the palm to turn and move the hand onto the surface before the fingers close.
 //

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "distance_test_meshes.h"
@@ -407,6 +408,45 @@ TEST_CASE("localSignedDistanceWithin: signedDistance within its bound, infinity 
   CHECK(within > 100);
   CHECK(beyond > 100);
   CHECK(std::isinf(d->localSignedDistanceWithin(glm::vec3(0.0f), -1.0f)));
+}
+
+TEST_CASE("localSignedDistanceNear gives localSignedDistanceWithin's result whatever the hint",
+          "[mesh_distance][local]") {
+  const TriangleMesh sphere = icosphereMesh(0.05f, 3);
+  const auto d = makeDistance(sphere);
+  const uint32_t triangles = uint32_t(sphere.triangleCount());
+  std::mt19937 rng(13);
+  std::uniform_int_distribution<uint32_t> anyTriangle(0, triangles - 1);
+  const std::vector<glm::vec3> points = samplePoints(sphere, 200, 50, 0.02f, rng);
+  int found = 0;
+  uint32_t previous = std::numeric_limits<uint32_t>::max();
+  for (const glm::vec3& p : points) {
+    for (float bound : {0.005f, 0.02f}) {
+      glm::vec3 q0(1e9f);
+      const float plain = d->localSignedDistanceWithin(p, bound, &q0);
+      // No hint, a random one (near or far), the previous point's, one out of range.
+      for (uint32_t hint :
+           {std::numeric_limits<uint32_t>::max(), anyTriangle(rng), previous, triangles + 5}) {
+        CAPTURE(p.x, p.y, p.z, bound, hint);
+        glm::vec3 q(1e9f);
+        uint32_t closest = std::numeric_limits<uint32_t>::max();
+        const float near = d->localSignedDistanceNear(p, bound, hint, &q, &closest);
+        if (std::isinf(plain)) {
+          CHECK(std::isinf(near));
+          CHECK(q.x == 1e9f);
+          CHECK(closest == std::numeric_limits<uint32_t>::max());
+          continue;
+        }
+        ++found;
+        CHECK(near == Approx(plain).margin(1e-6f));
+        CHECK(glm::length(q - q0) <= 1e-5f);
+        REQUIRE(closest < triangles);
+        CHECK(std::sqrt(glm::dot(p - q, p - q)) == Approx(std::abs(near)).margin(1e-6f));
+      }
+    }
+    d->localSignedDistanceNear(p, 0.02f, previous, nullptr, &previous);
+  }
+  CHECK(found > 400);
 }
 
 TEST_CASE("localSignedDistanceWithin on the open bunny agrees with ray parity near the surface",

@@ -15,16 +15,25 @@
 
 namespace sdfg::test {
 
+// The extension's functions (and the hand tracker's), as the app gets them.
 struct Ext {
   PFN_xrCreateGraspTargetSDFG create;
   PFN_xrDestroyGraspTargetSDFG destroy;
+  PFN_xrUpdateGraspTargetVerticesSDFG update;
+  PFN_xrSetGraspTargetPlacementSDFG place;
   PFN_xrGetGraspStateSDFG state;
+  PFN_xrSetGraspOptionsSDFG options;
   PFN_xrCreateHandTrackerEXT createTracker;
   explicit Ext(const App& app)
       : create(app.fn<PFN_xrCreateGraspTargetSDFG>("xrCreateGraspTargetSDFG")),
         destroy(app.fn<PFN_xrDestroyGraspTargetSDFG>("xrDestroyGraspTargetSDFG")),
+        update(app.fn<PFN_xrUpdateGraspTargetVerticesSDFG>("xrUpdateGraspTargetVerticesSDFG")),
+        place(app.fn<PFN_xrSetGraspTargetPlacementSDFG>("xrSetGraspTargetPlacementSDFG")),
         state(app.fn<PFN_xrGetGraspStateSDFG>("xrGetGraspStateSDFG")),
+        options(app.fn<PFN_xrSetGraspOptionsSDFG>("xrSetGraspOptionsSDFG")),
         createTracker(app.fn<PFN_xrCreateHandTrackerEXT>("xrCreateHandTrackerEXT")) {}
+  // Every grasp function was handed out.
+  bool ok() const { return create && destroy && update && place && state && options; }
 };
 
 inline XrHandTrackerEXT makeTracker(const App& app, const Ext& ext, XrHandEXT hand) {

@@ -5,28 +5,12 @@
 #include <cmath>
 #include <limits>
 
+#include "grasp_checks.h"
 #include "xr_harness.h"
 
 namespace {
 
 using namespace sdfg::test;
-
-struct Ext {
-  PFN_xrCreateGraspTargetSDFG create;
-  PFN_xrDestroyGraspTargetSDFG destroy;
-  PFN_xrUpdateGraspTargetVerticesSDFG update;
-  PFN_xrSetGraspTargetPlacementSDFG place;
-  PFN_xrGetGraspStateSDFG state;
-  PFN_xrSetGraspOptionsSDFG options;
-  explicit Ext(const App& app)
-      : create(app.fn<PFN_xrCreateGraspTargetSDFG>("xrCreateGraspTargetSDFG")),
-        destroy(app.fn<PFN_xrDestroyGraspTargetSDFG>("xrDestroyGraspTargetSDFG")),
-        update(app.fn<PFN_xrUpdateGraspTargetVerticesSDFG>("xrUpdateGraspTargetVerticesSDFG")),
-        place(app.fn<PFN_xrSetGraspTargetPlacementSDFG>("xrSetGraspTargetPlacementSDFG")),
-        state(app.fn<PFN_xrGetGraspStateSDFG>("xrGetGraspStateSDFG")),
-        options(app.fn<PFN_xrSetGraspOptionsSDFG>("xrSetGraspOptionsSDFG")) {}
-  bool ok() const { return create && destroy && update && place && state && options; }
-};
 
 // A tetrahedron, valid.
 const XrVector3f kVerts[4] = {{0, 0, 0}, {0.1f, 0, 0}, {0, 0.1f, 0}, {0, 0, 0.1f}};

@@ -24,6 +24,16 @@ class CpuBackend final : public SdfBackend {
   CpuSdfOptions options_;
 };
 
+// Finite, and min <= max on every axis (a flat box is fine).
+bool validBounds(const Aabb& bounds) {
+  for (int a = 0; a < 3; ++a) {
+    if (!std::isfinite(bounds.min[a]) || !std::isfinite(bounds.max[a]) ||
+        !(bounds.min[a] <= bounds.max[a]))
+      return false;
+  }
+  return true;
+}
+
 float angleBetween(const glm::quat& a, const glm::quat& b) {
   const float d = std::min(1.0f, std::abs(glm::dot(a, b)));
   return 2.0f * std::acos(d);
@@ -88,11 +98,7 @@ Status GraspSession::addTarget(uint64_t id, const TriangleMesh& mesh) {
 
 Status GraspSession::addDeviceTarget(uint64_t id, const Aabb& bounds) {
   if (targets_.count(id) != 0) return Status::invalid_argument;
-  for (int a = 0; a < 3; ++a) {
-    if (!std::isfinite(bounds.min[a]) || !std::isfinite(bounds.max[a]) ||
-        !(bounds.min[a] <= bounds.max[a]))
-      return Status::invalid_argument;
-  }
+  if (!validBounds(bounds)) return Status::invalid_argument;
   if (!deferredUsable() || !deferred_->hasDeviceMesh(id)) return Status::unsupported;
   Target t;
   t.bounds = bounds;
@@ -103,11 +109,7 @@ Status GraspSession::addDeviceTarget(uint64_t id, const Aabb& bounds) {
 Status GraspSession::updateTargetBounds(uint64_t id, const Aabb& bounds) {
   auto it = targets_.find(id);
   if (it == targets_.end() || it->second.distance != nullptr) return Status::invalid_argument;
-  for (int a = 0; a < 3; ++a) {
-    if (!std::isfinite(bounds.min[a]) || !std::isfinite(bounds.max[a]) ||
-        !(bounds.min[a] <= bounds.max[a]))
-      return Status::invalid_argument;
-  }
+  if (!validBounds(bounds)) return Status::invalid_argument;
   it->second.bounds = bounds;
   return Status::ok;
 }

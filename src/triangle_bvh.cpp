@@ -103,6 +103,7 @@ void TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const ui
     corners_.clear();
     frames_.clear();
     slotOf_.clear();
+    slabs_.clear();
     return;
   }
 
@@ -222,6 +223,9 @@ void TriangleBvh::refit(std::span<const glm::vec3> positions, std::span<const ui
 }
 
 void TriangleBvh::refitNodes() {
+  // Each subtree holds one contiguous run of leaf slots (the build partitions in place): end[i]
+  // is where node i's run ends, so a node's triangles are [first leaf slot, end).
+  std::vector<uint32_t> begin(nodes_.size()), end(nodes_.size());
   // Children follow their parent, so one backward pass sees children before parents.
   for (size_t i = nodes_.size(); i-- > 0;) {
     Node& node = nodes_[i];
@@ -240,7 +244,122 @@ void TriangleBvh::refitNodes() {
     }
     node.min = box.min;
     node.max = box.max;
+    begin[i] = node.count > 0 ? node.first : begin[node.first];
+    end[i] = node.count > 0 ? node.first + node.count : end[node.first + 1];
   }
+
+  // Slabs, bottom-up in one more backward pass. A leaf measures its corners; an inner node
+  // bounds each child's region (its box, and its ball and slab) along its own normal, so a refit
+  // (updatePositions() of a deforming target) stays O(n).
+  slabs_.assign(nodes_.size(), Slab{});
+  std::vector<glm::dvec3> areaSum(nodes_.size());  // sum of the triangles' cross products
+  std::vector<double> areaTotal(nodes_.size());    // sum of their lengths
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  for (size_t i = nodes_.size(); i-- > 0;) {
+    const Node& node = nodes_[i];
+    Slab& slab = slabs_[i];
+    slab.lo = -kInf;
+    slab.hi = kInf;
+    slab.radius = kInf;
+    glm::dvec3 sum(0.0);
+    double area = 0.0;
+    if (node.count > 0) {
+      for (uint32_t s = node.first; s < node.first + node.count; ++s) {
+        const glm::dvec3 a(corners_[s].a), b(corners_[s].b), c(corners_[s].c);
+        const glm::dvec3 cr = glm::cross(b - a, c - a);
+        sum += cr;
+        area += glm::length(cr);
+      }
+    } else {
+      sum = areaSum[node.first] + areaSum[node.first + 1];
+      area = areaTotal[node.first] + areaTotal[node.first + 1];
+    }
+    areaSum[i] = sum;
+    areaTotal[i] = area;
+    if (end[i] - begin[i] > kSlabTriangles) continue;
+    // The area-weighted mean normal: on a smooth patch the direction the patch is thinnest in.
+    const double len = glm::length(sum);
+    if (!(len > 0.5 * area) || !(len > 0.0)) continue;  // a fold or a crease: no useful plane
+    // The bounds are measured from the single-precision normal and centre the query uses, so
+    // only the query's own arithmetic can err.
+    const glm::vec3 normalF(sum / len);
+    const glm::vec3 centreF(0.5f * (node.min + node.max));
+    const glm::dvec3 normal(normalF), centre(centreF);
+    double lo = std::numeric_limits<double>::max(), hi = -lo, radius = 0.0;
+    if (node.count > 0) {
+      double radius2 = 0.0;
+      for (uint32_t s = node.first; s < node.first + node.count; ++s) {
+        for (const glm::vec3& v : {corners_[s].a, corners_[s].b, corners_[s].c}) {
+          const glm::dvec3 d = glm::dvec3(v) - centre;
+          const double h = glm::dot(normal, d);
+          lo = std::min(lo, h);
+          hi = std::max(hi, h);
+          radius2 = std::max(radius2, glm::dot(d, d));
+        }
+      }
+      radius = std::sqrt(radius2);
+    } else {
+      for (uint32_t k = node.first; k < node.first + 2; ++k) {
+        const Node& child = nodes_[k];
+        const Slab& cs = slabs_[k];
+        // The child's box: centre +- half extents.
+        const glm::dvec3 boxCentre = 0.5 * (glm::dvec3(child.min) + glm::dvec3(child.max));
+        const glm::dvec3 half = 0.5 * (glm::dvec3(child.max) - glm::dvec3(child.min));
+        const double boxAt = glm::dot(normal, boxCentre - centre);
+        const double boxReach = glm::dot(glm::abs(normal), half);
+        double cLo = boxAt - boxReach, cHi = boxAt + boxReach;
+        double cRadius = glm::length(boxCentre - centre) + glm::length(half);
+        if (cs.radius < kInf) {
+          // Along the parent's normal n = alpha n_k + beta t (t across n_k): the child's slab
+          // gives alpha [lo_k, hi_k], its ball beta [-R_k, R_k].
+          const glm::dvec3 ck(cs.centre);
+          const double alpha = glm::dot(normal, glm::dvec3(cs.normal));
+          const double beta = std::sqrt(std::max(0.0, 1.0 - alpha * alpha));
+          const double at = glm::dot(normal, ck - centre);
+          const double a0 = alpha * double(cs.lo), a1 = alpha * double(cs.hi);
+          cLo = std::max(cLo, at + std::min(a0, a1) - beta * double(cs.radius));
+          cHi = std::min(cHi, at + std::max(a0, a1) + beta * double(cs.radius));
+          cRadius = std::min(cRadius, glm::length(ck - centre) + double(cs.radius));
+        }
+        lo = std::min(lo, cLo);
+        hi = std::max(hi, cHi);
+        radius = std::max(radius, cRadius);
+      }
+      // Everything in the box is within half its diagonal of its centre.
+      radius = std::min(radius, 0.5 * glm::length(glm::dvec3(node.max) - glm::dvec3(node.min)));
+    }
+    slab.normal = normalF;
+    slab.centre = centreF;
+    const double pad = 1e-6 * radius;  // rounds the float bounds outwards
+    slab.lo = float(lo - pad);
+    slab.hi = float(hi + pad);
+    slab.radius = float(radius + pad);
+  }
+}
+
+float TriangleBvh::nodeDistanceSquared(const glm::vec3& p, uint32_t i, double best) const {
+  const Node& node = nodes_[i];
+  const float box = boxDistanceSquared(p, node.min, node.max);
+  const Slab& slab = slabs_[i];
+  // Already pruned by its box, or a node without a slab.
+  if (double(box) >= best || !(slab.radius < std::numeric_limits<float>::infinity())) return box;
+  // The triangles lie in the ball (centre, radius) and in the slab lo <= axial <= hi about the
+  // centre, so any of them is at least the axial gap away along the normal and at least the
+  // radial gap (distance from the normal's line through the centre, minus the radius) across
+  // it: the squared distance is at least the sum of the two squares.
+  const glm::vec3 d = p - slab.centre;
+  const float axial = glm::dot(slab.normal, d);
+  const glm::vec3 across = d - axial * slab.normal;
+  const float radial2 = glm::dot(across, across);
+  // Single-precision rounding of both grows with |d| (a few 1e-7 |d|); an allowance of 1e-5 |d|
+  // is well above it and costs the bound only that fraction.
+  const float slack = 1e-5f * (std::abs(axial) + std::abs(d.x) + std::abs(d.y) + std::abs(d.z));
+  const float axialGap = std::max(std::max(slab.lo - axial, axial - slab.hi) - slack, 0.0f);
+  float radialGap = 0.0f;
+  if (radial2 > slab.radius * slab.radius) {
+    radialGap = std::max(std::sqrt(radial2) - slab.radius - slack, 0.0f);
+  }
+  return std::max(box, axialGap * axialGap + radialGap * radialGap);
 }
 
 TriangleBvh::Hit TriangleBvh::evaluate(const glm::vec3& p, uint32_t triangle) const {
@@ -269,7 +388,7 @@ TriangleBvh::Hit TriangleBvh::closest(const glm::vec3& p, Hit seed) const {
   const glm::dvec3 pd(p);
 
   uint32_t current = 0;
-  if (prunable(boxDistanceSquared(p, nodes_[0].min, nodes_[0].max))) return best;
+  if (prunable(nodeDistanceSquared(p, 0, best.distanceSquared))) return best;
   for (;;) {
     const Node& node = nodes_[current];
     if (node.count > 0) {
@@ -283,8 +402,8 @@ TriangleBvh::Hit TriangleBvh::closest(const glm::vec3& p, Hit seed) const {
       }
     } else {
       uint32_t nearChild = node.first, farChild = node.first + 1;
-      float nearD = boxDistanceSquared(p, nodes_[nearChild].min, nodes_[nearChild].max);
-      float farD = boxDistanceSquared(p, nodes_[farChild].min, nodes_[farChild].max);
+      float nearD = nodeDistanceSquared(p, nearChild, best.distanceSquared);
+      float farD = nodeDistanceSquared(p, farChild, best.distanceSquared);
       if (farD < nearD) {
         std::swap(nearChild, farChild);
         std::swap(nearD, farD);
@@ -423,7 +542,8 @@ void TriangleBvh::closestPacket(std::span<const glm::vec3> points, std::span<Hit
 
   // Lanes for which node `n`'s box is not ruled out by the lane's best so far (the same test as
   // closest(), done in float against bounds rounded up, so it keeps at least what it keeps).
-  const auto liveLanes = [&](const Node& n) {
+  const auto liveLanes = [&](uint32_t index) {
+    const Node& n = nodes_[index];
     const F4 mnx = splat(n.min.x), mny = splat(n.min.y), mnz = splat(n.min.z);
     const F4 mxx = splat(n.max.x), mxy = splat(n.max.y), mxz = splat(n.max.z);
     uint32_t bits = 0;
@@ -434,7 +554,27 @@ void TriangleBvh::closestPacket(std::span<const glm::vec3> points, std::span<Hit
       const F4 d2 = dx * dx + dy * dy + dz * dz;
       bits |= laneBits(d2 * splat(kShrink) < load(bound2, h)) << (4 * h);
     }
-    return bits;
+    // The slab bound of nodeDistanceSquared(), lane by lane, for the lanes the box kept.
+    const Slab& slab = slabs_[index];
+    if (bits == 0 || !(slab.radius < std::numeric_limits<float>::infinity())) return bits;
+    uint32_t slabBits = 0;
+    for (int h = 0; h < kHalves; ++h) {
+      if (((bits >> (4 * h)) & 15u) == 0) continue;
+      const F4 dx = X[h] - splat(slab.centre.x), dy = Y[h] - splat(slab.centre.y),
+               dz = Z[h] - splat(slab.centre.z);
+      const F4 axial = dx * slab.normal.x + dy * slab.normal.y + dz * slab.normal.z;
+      const F4 ax = dx - axial * slab.normal.x, ay = dy - axial * slab.normal.y,
+               az = dz - axial * slab.normal.z;
+      const F4 radial = vsqrt(ax * ax + ay * ay + az * az);
+      const F4 absAxial = vmax(axial, -axial);
+      const F4 slack = splat(1e-5f) * (absAxial + vmax(dx, -dx) + vmax(dy, -dy) + vmax(dz, -dz));
+      const F4 axialGap =
+          vmax(vmax(splat(slab.lo) - axial, axial - splat(slab.hi)) - slack, splat(0.0f));
+      const F4 radialGap = vmax(radial - splat(slab.radius) - slack, splat(0.0f));
+      const F4 d2 = axialGap * axialGap + radialGap * radialGap;
+      slabBits |= laneBits(d2 * splat(kShrink) < load(bound2, h)) << (4 * h);
+    }
+    return bits & slabBits;
   };
 
   const glm::dvec3 pd[kPacketSize] = {glm::dvec3(points[0]),
@@ -515,7 +655,7 @@ void TriangleBvh::closestPacket(std::span<const glm::vec3> points, std::span<Hit
   std::array<Entry, kStackSize> stack;
   size_t top = 0;
   uint32_t current = 0;
-  uint32_t live = liveLanes(nodes_[0]);
+  uint32_t live = liveLanes(0);
   if (live == 0) return;
   for (;;) {
     const Node& node = nodes_[current];
@@ -523,8 +663,8 @@ void TriangleBvh::closestPacket(std::span<const glm::vec3> points, std::span<Hit
       leaf(node, live);
     } else {
       uint32_t nearChild = node.first, farChild = node.first + 1;
-      uint32_t nearLive = live & liveLanes(nodes_[nearChild]);
-      uint32_t farLive = live & liveLanes(nodes_[farChild]);
+      uint32_t nearLive = live & liveLanes(nearChild);
+      uint32_t farLive = live & liveLanes(farChild);
       // Nearer child first, as seen from the packet's centre.
       if (boxDistanceSquared(centre, nodes_[farChild].min, nodes_[farChild].max) <
           boxDistanceSquared(centre, nodes_[nearChild].min, nodes_[nearChild].max)) {
@@ -547,7 +687,7 @@ void TriangleBvh::closestPacket(std::span<const glm::vec3> points, std::span<Hit
     bool next = false;
     while (top > 0) {
       const Entry e = stack[--top];
-      const uint32_t lanes = e.lanes & liveLanes(nodes_[e.node]);
+      const uint32_t lanes = e.lanes & liveLanes(e.node);
       if (lanes != 0) {
         current = e.node;
         live = lanes;

@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -120,6 +121,57 @@ TEST_CASE("Closest points match brute force on analytic meshes", "[mesh_distance
   }
   SECTION("icosphere") {
     checkAgainstBruteForce(icosphereMesh(0.05f, 3), 300, 200, 2);
+  }
+}
+
+// The slab bounds of small nodes (TriangleBvh::kSlabTriangles) prune by the plane and the ball
+// of a patch, in single precision: nothing that could be the closest may be pruned, also far
+// from the origin (where rounding grows with the coordinates) and for points a few millimetres
+// off a dense surface (what the solver's exact check asks).
+TEST_CASE("Slab-bounded closest-point queries equal brute force, near and far from the origin",
+          "[mesh_distance][bvh]") {
+  const glm::vec3 offsets[] = {glm::vec3(0.0f), glm::vec3(1000.0f, -500.0f, 250.0f)};
+  for (const glm::vec3& offset : offsets) {
+    TriangleMesh m = icosphereMesh(0.05f, 5);  // 20480 triangles, edges about 2 mm
+    for (glm::vec3& v : m.positions) v += offset;
+    TriangleBvh bvh;
+    bvh.build(m.positions, m.indices);
+    const auto bruteForce2 = [&m](const glm::vec3& p) {
+      double best = std::numeric_limits<double>::infinity();
+      for (size_t t = 0; t < m.triangleCount(); ++t) {
+        const glm::dvec3 a(m.positions[m.indices[3 * t]]), b(m.positions[m.indices[3 * t + 1]]),
+            c(m.positions[m.indices[3 * t + 2]]);
+        best = std::min(best, closestPointOnTriangle(glm::dvec3(p), a, b, c).distanceSquared);
+      }
+      return best;
+    };
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    std::uniform_real_distribution<float> gap(0.0005f, 0.015f);
+    for (int i = 0; i < 300; ++i) {
+      glm::vec3 dir(unit(rng), unit(rng), unit(rng));
+      if (glm::length(dir) < 1e-3f) continue;
+      dir = glm::normalize(dir);
+      // Outside (the finger's side), inside, and one far point in ten.
+      const float r = i % 10 == 0 ? 0.3f : 0.05f + (i % 2 == 0 ? gap(rng) : -gap(rng));
+      const glm::vec3 p = offset + r * dir;
+      CAPTURE(offset.x, i, r);
+      const TriangleBvh::Hit hit = bvh.closest(p);
+      REQUIRE(hit.found());
+      CHECK(hit.distanceSquared == bruteForce2(p));
+      // The packet walk (SDF builds): p and seven neighbours 1 mm apart, as grid nodes are.
+      if (i % 3 == 0) {
+        std::array<glm::vec3, TriangleBvh::kPacketSize> block{};
+        std::array<TriangleBvh::Hit, TriangleBvh::kPacketSize> hits{};
+        for (size_t k = 0; k < block.size(); ++k) {
+          block[k] = p + 0.001f * glm::vec3(float(k & 1), float((k >> 1) & 1), float(k >> 2));
+        }
+        bvh.closestPacket(block, hits);
+        for (size_t k = 0; k < block.size(); ++k) {
+          CHECK(hits[k].distanceSquared == bruteForce2(block[k]));
+        }
+      }
+    }
   }
 }
 

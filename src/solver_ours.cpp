@@ -680,14 +680,30 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
   // far the group may close from here: no more than its clearance on the field allows (the
   // interpolant's slope bound), so none reaches the surface unseen. `highest`: that limit.
   float highest = 1.0f;
+  // Each sphere's last trilinear clearance read here and its curl: the trilinear interpolant is
+  // kInterpolantLipschitz-Lipschitz, so while that bound keeps a sphere beyond kExactBand +
+  // kCorrectBand (where neither reading can make it a candidate) it is not read again and the
+  // bound limits the reach instead (a little more cautious than its value).
+  std::array<float, kMaxSpheres> readA{}, readG{};
+  std::array<bool, kMaxSpheres> read{};
   auto select = [&](float v) {
     float reach = 1.0f - v;
     for (int i = 0; i < fr.sphereCount; ++i) {
       const Sphere& s = fr.spheres[i];
       if (s.bone < firstFree || isCand[i]) continue;
+      if (read[i]) {
+        const float bound = readG[i] - kInterpolantLipschitz * speed[i] * std::abs(v - readA[i]);
+        if (bound >= kExactBand + kCorrectBand) {
+          if (speed[i] > 0.0f) reach = std::min(reach, bound / (kInterpolantLipschitz * speed[i]));
+          continue;
+        }
+      }
       const glm::vec3 uvw = *cx.toBox * centreOf(s) + cx.toBoxOffset;
       const float value = (*cx.sample)(uvw);
       float g = value - s.testRadius;
+      read[i] = true;
+      readA[i] = v;
+      readG[i] = g;
       // As in evaluate(): the corrected reading only matters where it can be lower.
       if (g < kExactBand + kCorrectBand) {
         g = std::min(value, cx.sample->corrected(uvw, value)) - s.testRadius;

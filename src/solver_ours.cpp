@@ -45,6 +45,12 @@ constexpr int kMaxExactBackoff = 6;
 // sample per pose instead of one per candidate. A sphere whose field clearance is wrong by more
 // can only be missed while another, nearer one is touching.
 constexpr float kFieldTrust = 0.001f;  // metres
+// The exact check's last secant step is not sampled again when it moves the clearance by at
+// most this (the step's own error is a fraction of it).
+constexpr float kUnverifiedStep = 0.001f;  // metres
+// Where the exact check follows, the field's stop is refined only to this: the 16^3 field is
+// off by about this much near curved parts anyway, and the check corrects the rest.
+constexpr float kFieldStopTolerance = 0.0005f;  // metres
 // A first step on the field's slope (no secant yet) moves no sphere more than its clearance plus
 // this, so none can pass through a thin part on a wrong slope.
 constexpr float kFieldSlopeReach = 0.002f;  // metres
@@ -449,7 +455,8 @@ float OursSolver::stage(Stage& st, JointCurls& curls, float a, int& touching, gl
   const FingerRig& fr = fingers_[st.finger];
   const int firstFree = st.firstFree;
   const int n = fr.joints;
-  const float tol = kContactTolerance;
+  // With the exact check after it, a stop within the field's own error is all the check needs.
+  const float tol = st.polish ? kContactTolerance : kFieldStopTolerance;
   auto at = [&](float v, Eval& e) {
     for (int j = firstFree; j < n; ++j) curls[j] = v;
     evaluate(st, curls, v, e, false);
@@ -832,6 +839,16 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
     return (g1 - g0) / dv;
   };
 
+  // Whether every candidate but `arg` is certainly clear at curl v (bounds from the samples).
+  auto othersClear = [&](float v, int arg) {
+    for (int k = 0; k < count; ++k) {
+      if (cand[k] != arg && lastG[k] - speed[cand[k]] * std::abs(v - lastA[k]) < 0.0f) {
+        return false;
+      }
+    }
+    return true;
+  };
+
   ExactEval cur;
   measure(a, cur);
   if (cur.arg < 0 && touching < 0) {  // nothing near: the field's pose stands
@@ -891,6 +908,20 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
     // clear.
     if (aSafe >= 0.0f && next < aSafe) next = aSafe + 0.5f * (aCur - aSafe);
     if (std::abs(next - aCur) < 1e-7f) break;
+    // A small last correction is taken without sampling it again: the secant (or the field's
+    // slope) errs by a fraction of the step, so the pose lands within that fraction of touching,
+    // and the other candidates' bounds keep them clear of it.
+    if (cur.arg >= 0 && std::abs(cur.g - 0.5f * tol) <= kUnverifiedStep &&
+        othersClear(next, cur.arg)) {
+      setCurl(next);
+      jointPositions(f, curls, hand);
+      aSafe = next;
+      safe = cur;
+      safe.centre = centreOf(fr.spheres[cur.arg]);
+      safe.distance = cur.distance - (cur.g - 0.5f * tol);
+      safe.g = 0.5f * tol;
+      break;
+    }
     aPrev = aCur;
     gPrev = cur.g;
     argPrev = cur.arg;

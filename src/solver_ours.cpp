@@ -47,7 +47,7 @@ constexpr int kMaxExactBackoff = 6;
 constexpr float kFieldTrust = 0.001f;  // metres
 // The exact check's last secant step is not sampled again when it moves the clearance by at
 // most this (the step's own error is a fraction of it).
-constexpr float kUnverifiedStep = 0.001f;  // metres
+constexpr float kUnverifiedStep = 0.0003f;  // metres
 // Where the exact check follows, the field's stop is refined only to this: the 16^3 field is
 // off by about this much near curved parts anyway, and the check corrects the rest.
 constexpr float kFieldStopTolerance = 0.0005f;  // metres

@@ -20,6 +20,40 @@ set datafile missing 'NaN'
 set grid ytics lc rgb '#dddddd'
 set border 3
 set tics nomirror
+set output '../img/bench/check_us.png'
+set title 'check_us median per method and mesh'
+set ylabel 'check_us median'
+set style data histograms
+set style histogram clustered gap 1
+set style fill solid 0.85 border -1
+set boxwidth 0.9
+set key outside right top
+set xtics rotate by -25
+set yrange [0:*]
+plot for [i=2:5] 'check_us.dat' using i:xtic(1) title columnheader(i)
+reset
+set terminal pngcairo size 1000,520 noenhanced font 'sans,10'
+set datafile missing 'NaN'
+set grid ytics lc rgb '#dddddd'
+set border 3
+set tics nomirror
+set output '../img/bench/exact_samples_mean.png'
+set title 'exact_samples_mean per method and mesh'
+set ylabel 'exact_samples_mean'
+set style data histograms
+set style histogram clustered gap 1
+set style fill solid 0.85 border -1
+set boxwidth 0.9
+set key outside right top
+set xtics rotate by -25
+set yrange [0:*]
+plot for [i=2:5] 'exact_samples_mean.dat' using i:xtic(1) title columnheader(i)
+reset
+set terminal pngcairo size 1000,520 noenhanced font 'sans,10'
+set datafile missing 'NaN'
+set grid ytics lc rgb '#dddddd'
+set border 3
+set tics nomirror
 set output '../img/bench/tip_residual_mm.png'
 set title 'tip_residual_mm median per method and mesh'
 set ylabel 'tip_residual_mm median'
@@ -31,6 +65,40 @@ set key outside right top
 set xtics rotate by -25
 set yrange [0:*]
 plot for [i=2:5] 'tip_residual_mm.dat' using i:xtic(1) title columnheader(i)
+reset
+set terminal pngcairo size 1000,520 noenhanced font 'sans,10'
+set datafile missing 'NaN'
+set grid ytics lc rgb '#dddddd'
+set border 3
+set tics nomirror
+set output '../img/bench/contact_residual_mm.png'
+set title 'contact_residual_mm median per method and mesh'
+set ylabel 'contact_residual_mm median'
+set style data histograms
+set style histogram clustered gap 1
+set style fill solid 0.85 border -1
+set boxwidth 0.9
+set key outside right top
+set xtics rotate by -25
+set yrange [0:*]
+plot for [i=2:5] 'contact_residual_mm.dat' using i:xtic(1) title columnheader(i)
+reset
+set terminal pngcairo size 1000,520 noenhanced font 'sans,10'
+set datafile missing 'NaN'
+set grid ytics lc rgb '#dddddd'
+set border 3
+set tics nomirror
+set output '../img/bench/pass_through.png'
+set title 'pass_through per method and mesh'
+set ylabel 'pass_through'
+set style data histograms
+set style histogram clustered gap 1
+set style fill solid 0.85 border -1
+set boxwidth 0.9
+set key outside right top
+set xtics rotate by -25
+set yrange [0:*]
+plot for [i=2:5] 'pass_through.dat' using i:xtic(1) title columnheader(i)
 reset
 set terminal pngcairo size 1000,520 noenhanced font 'sans,10'
 set datafile missing 'NaN'

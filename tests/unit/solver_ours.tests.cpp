@@ -47,6 +47,15 @@ float boxDistance(const glm::vec3& p, const glm::vec3& centre, const glm::vec3& 
   return outside + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0f);
 }
 
+// The analytic targets several cases share: a 3.5 cm ball and a 16 x 5 x 6 cm box, both where
+// the closing fingers meet them.
+float sphereUnderFingers(const glm::vec3& p) {
+  return glm::length(p - glm::vec3(0.0f, -0.07f, -0.11f)) - 0.035f;
+}
+float boxUnderFingers(const glm::vec3& p) {
+  return boxDistance(p, glm::vec3(0.0f, -0.08f, -0.12f), glm::vec3(0.08f, 0.025f, 0.03f));
+}
+
 // Every capsule sphere of a finger in its final pose: proximal joint to tip, dense, with the
 // joint radii interpolated (the evaluator's capsule model).
 struct CapsulePoint {
@@ -125,14 +134,8 @@ TEST_CASE("ours: fingers stop on the surface of analytic shapes, never inside", 
   };
   const Shape shapes[] = {
       {"plane below the palm", [](const glm::vec3& p) { return p.y + 0.06f; }},
-      {"sphere under the fingers",
-       [](const glm::vec3& p) {
-         return glm::length(p - glm::vec3(0.0f, -0.07f, -0.11f)) - 0.035f;
-       }},
-      {"box under the fingers",
-       [](const glm::vec3& p) {
-         return boxDistance(p, glm::vec3(0.0f, -0.08f, -0.12f), glm::vec3(0.08f, 0.025f, 0.03f));
-       }},
+      {"sphere under the fingers", sphereUnderFingers},
+      {"box under the fingers", boxUnderFingers},
   };
   for (const Shape& shape : shapes) {
     for (uint32_t resolution : {16u, 32u}) {
@@ -304,8 +307,7 @@ TEST_CASE("ours: rejects bad options and scenes without a field", "[solver][ours
 }
 
 TEST_CASE("ours: solve time per grasp on a 16^3 field", "[solver][ours][timing]") {
-  const SdfGrid grid = analyticGrid(
-      [](const glm::vec3& p) { return glm::length(p - glm::vec3(0.0f, -0.07f, -0.11f)) - 0.035f; });
+  const SdfGrid grid = analyticGrid(sphereUnderFingers);
   const HandModel hand = HandModel::defaultAdult(Hand::right);
   OursSolver solver;
   REQUIRE(solver.prepare(hand, grid.box(), SolverOptions{}) == Status::ok);
@@ -514,14 +516,8 @@ TEST_CASE("ours with an exact source: contacts end within 0.1 mm of touching, no
   };
   const glm::vec3 plateCentre(0.0f, -0.03f, -0.17f), plateHalf(0.1f, 0.002f, 0.03f);
   const Shape shapes[] = {
-      {"sphere under the fingers",
-       [](const glm::vec3& p) {
-         return glm::length(p - glm::vec3(0.0f, -0.07f, -0.11f)) - 0.035f;
-       }},
-      {"box under the fingers",
-       [](const glm::vec3& p) {
-         return boxDistance(p, glm::vec3(0.0f, -0.08f, -0.12f), glm::vec3(0.08f, 0.025f, 0.03f));
-       }},
+      {"sphere under the fingers", sphereUnderFingers},
+      {"box under the fingers", boxUnderFingers},
       {"4 mm plate across the finger paths",
        [&](const glm::vec3& p) { return boxDistance(p, plateCentre, plateHalf); }},
   };
@@ -558,9 +554,7 @@ TEST_CASE("ours with an exact source: contacts end within 0.1 mm of touching, no
 
 TEST_CASE("ours without an exact source samples nothing and solves as on the field alone",
           "[solver][ours][exact]") {
-  const DistanceFn sphere = [](const glm::vec3& p) {
-    return glm::length(p - glm::vec3(0.0f, -0.07f, -0.11f)) - 0.035f;
-  };
+  const DistanceFn sphere = sphereUnderFingers;
   const SdfGrid grid = analyticGrid(sphere, 16);
   const Solved plain = solveOurs(grid);
   const Solved none = solveOursExact(grid, nullptr);

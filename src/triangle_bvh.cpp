@@ -223,9 +223,7 @@ void TriangleBvh::refit(std::span<const glm::vec3> positions, std::span<const ui
 }
 
 void TriangleBvh::refitNodes() {
-  // Each subtree holds one contiguous run of leaf slots (the build partitions in place): end[i]
-  // is where node i's run ends, so a node's triangles are [first leaf slot, end).
-  std::vector<uint32_t> begin(nodes_.size()), end(nodes_.size());
+  std::vector<uint32_t> triangles(nodes_.size());  // in each node's subtree
   // Children follow their parent, so one backward pass sees children before parents.
   for (size_t i = nodes_.size(); i-- > 0;) {
     Node& node = nodes_[i];
@@ -244,8 +242,7 @@ void TriangleBvh::refitNodes() {
     }
     node.min = box.min;
     node.max = box.max;
-    begin[i] = node.count > 0 ? node.first : begin[node.first];
-    end[i] = node.count > 0 ? node.first + node.count : end[node.first + 1];
+    triangles[i] = node.count > 0 ? node.count : triangles[node.first] + triangles[node.first + 1];
   }
 
   // Slabs, bottom-up in one more backward pass. A leaf measures its corners; an inner node
@@ -276,7 +273,7 @@ void TriangleBvh::refitNodes() {
     }
     areaSum[i] = sum;
     areaTotal[i] = area;
-    if (end[i] - begin[i] > kSlabTriangles) continue;
+    if (triangles[i] > kSlabTriangles) continue;
     // The area-weighted mean normal: on a smooth patch the direction the patch is thinnest in.
     const double len = glm::length(sum);
     if (!(len > 0.5 * area) || !(len > 0.0)) continue;  // a fold or a crease: no useful plane

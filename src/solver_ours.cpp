@@ -745,8 +745,6 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
   select(a);
   if (count == 0 || !(maxSpeed > 0.0f)) return a;
 
-  // Samples candidate k at the current joint positions; returns its clearance (or the lower
-  // bound the bounded search gave) and records it.
   // Joint positions a little further along the curl than `hand`, for the spheres' velocities;
   // computed once per pose, when a sample first needs it.
   std::array<glm::vec3, kMaxJoints + 1> ahead{};
@@ -762,6 +760,8 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
     const glm::vec3 next = ahead[s.bone] + s.t * (ahead[s.bone + 1] - ahead[s.bone]);
     return (next - centreOf(s)) / aheadStep;
   };
+  // Samples candidate k at the current joint positions; records its clearance (or the lower
+  // bound the bounded search gave) and, from the closest point, its exact slope along the curl.
   auto sampleOne = [&](int k, float v, ExactEval& r) {
     const Sphere& s = fr.spheres[cand[k]];
     exactSlope[k] = std::numeric_limits<float>::quiet_NaN();

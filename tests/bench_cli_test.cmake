@@ -1,5 +1,5 @@
 # Drives the built autograsp-bench like a user: a short run writes JSON with every key and finite
-# numbers; a broken mesh file is named, skipped, and the rest still runs; bad option values are a
+# numbers; --exact-check off leaves the exact check out of the "ours" rows; a broken mesh file is named, skipped, and the rest still runs; bad option values are a
 # usage error (exit 2); --sdf-backend vulkan without a device leaves its rows out and exits 3.
 # With -DPART=vulkan (a Vulkan device, e.g. lavapipe): --sdf-backend cpu,vulkan gives both rows
 # with finite figures, and --scaling-quick both columns; no device prints SDFG_SKIPPED.
@@ -153,6 +153,42 @@ if(NOT out MATCHES "Solve time per grasp" OR NOT out MATCHES "Quality")
   message(FATAL_ERROR "tables missing from the output:\n${out}")
 endif()
 
+# 1b. --exact-check: on by default ("ours" rows carry the check's time and samples); off runs
+# "ours" on the SDF alone, so its rows have none, and the JSON says which it was.
+function(ours_check_keys json out_var)
+  set(found "")
+  string(JSON rows LENGTH "${json}" rows)
+  math(EXPR last "${rows} - 1")
+  foreach(i RANGE ${last})
+    string(JSON method GET "${json}" rows ${i} method)
+    if(method STREQUAL "ours")
+      string(JSON type ERROR_VARIABLE err TYPE "${json}" rows ${i} check_us)
+      if(err)
+        set(type "none")
+      endif()
+      list(APPEND found "${type}")
+    endif()
+  endforeach()
+  set(${out_var} "${found}" PARENT_SCOPE)
+endfunction()
+string(JSON exact GET "${json}" exact_check)
+ours_check_keys("${json}" types)
+if(NOT exact STREQUAL "ON" OR NOT types STREQUAL "OBJECT;OBJECT;OBJECT")
+  message(FATAL_ERROR "default run: exact_check ${exact}, ours check_us types \"${types}\"")
+endif()
+execute_process(COMMAND "${BENCH}" --embedded-only --placements 3 --methods ours --exact-check off
+  --json "${WORK}/field-only.json" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "--exact-check off exited ${rc}\n${out}\n${err}")
+endif()
+file(READ "${WORK}/field-only.json" json)
+string(JSON exact GET "${json}" exact_check)
+ours_check_keys("${json}" types)
+if(NOT exact STREQUAL "OFF" OR NOT types STREQUAL "none;none;none")
+  message(FATAL_ERROR "--exact-check off: exact_check ${exact}, ours check_us types \"${types}\"")
+endif()
+check_rows("${json}" 3)
+
 # 2. A broken file is named and skipped; the good file after it still runs; exit non-zero.
 file(WRITE "${WORK}/broken.obj" "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n")
 file(WRITE "${WORK}/cube.obj" "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\n"
@@ -178,7 +214,7 @@ check_row("${json}" 0 3)
 
 # 3. Bad option values are usage errors.
 foreach(args "--placements;abc" "--methods;nope" "--resolution;1" "--da;0" "--bogus"
-    "--sdf-backend;gpu" "--sdf-backend;,")
+    "--sdf-backend;gpu" "--sdf-backend;," "--exact-check;maybe" "--exact-check")
   execute_process(COMMAND "${BENCH}" ${args} RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
   if(NOT rc EQUAL 2 OR NOT err MATCHES "usage")
     message(FATAL_ERROR "\"${args}\" exited ${rc}, expected 2 with usage:\n${err}")

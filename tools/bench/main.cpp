@@ -63,6 +63,8 @@ const char* kUsage =
     "  --methods LIST     comma-separated strategies (default: all)\n"
     "  --da X             curl step of the solvers, in (0, 1] (default 0.1)\n"
     "  --resolution N     SDF grid nodes per axis, 2..128 (default 16)\n"
+    "  --exact-check on|off  on (default): \"ours\" checks and corrects its stops on the exact\n"
+    "                     mesh distance (GraspScene::exact); off: on the SDF alone\n"
     "  --threads N        worker threads for SDF builds and grading (default: all cores)\n"
     "  --sdf-backend LIST comma-separated SDF builders: cpu, vulkan (default cpu); each SDF\n"
     "                     method gets one row per backend, solving on that backend's field.\n"
@@ -99,6 +101,7 @@ struct Options {
   int resolution = 16;
   unsigned threads = 0;
   float sdfFarBand = 0.0f;  // CpuSdfOptions::exactBand of the cpu builder
+  bool exactCheck = true;   // pass GraspScene::exact ("ours" checks its stops on the mesh)
   std::vector<std::string> sdfBackends = {tools::kCpuBackend};
   bool sdfBackendsGiven = false;  // else --scaling compares cpu and vulkan
   std::string json;
@@ -215,6 +218,11 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
         return UsageError{"--resolution: \"" + v + "\" is not 2..128"};
       }
       o.resolution = int(n);
+    } else if (arg == "--exact-check") {
+      if (auto e = needValue(v)) return e;
+      if (v != "on" && v != "off")
+        return UsageError{"--exact-check: \"" + v + "\" is not on or off"};
+      o.exactCheck = v == "on";
     } else if (arg == "--threads") {
       if (auto e = needValue(v)) return e;
       if (!parseInt(v, 0, 1024, n)) return UsageError{"--threads: \"" + v + "\" is not 0..1024"};
@@ -531,7 +539,7 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
       scene.objectFromHand = placement.objectFromHand;
       scene.collider = method.collider.get();
       // "ours" checks its stops on the exact distance of the same mesh the SDF is built from.
-      scene.exact = &exactSource;
+      scene.exact = o.exactCheck ? &exactSource : nullptr;
       if (rowBuilder[r] >= 0) {
         scene.field = &grids[size_t(rowBuilder[r])];
         rows[r].sdfBuildMs.push_back(buildMs[size_t(rowBuilder[r])]);
@@ -631,7 +639,7 @@ bool writeJson(const std::string& file, const Options& o, const std::vector<Row>
   if (!out) return false;
   out << "{\n  \"placements\": " << o.placements << ",\n  \"da\": " << jsonNumber(o.da)
       << ",\n  \"resolution\": " << o.resolution << ",\n  \"seed\": " << o.seed
-      << ",\n  \"rows\": [";
+      << ",\n  \"exact_check\": " << (o.exactCheck ? "true" : "false") << ",\n  \"rows\": [";
   for (size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
     const double nan = std::nan("");

@@ -23,7 +23,8 @@ endif()
 file(READ "${dir}/benchmarks.md" md)
 
 foreach(needle "--report" "## Speed" "## Quality" "SDF build time against triangle count"
-    "SDF build time against grid resolution" "| CPU |" "hardware threads")
+    "SDF build time against grid resolution" "| CPU |" "hardware threads"
+    "| run settings | placements 5, " "exact_check on")
   string(FIND "${md}" "${needle}" at)
   if(at EQUAL -1)
     message(FATAL_ERROR "benchmarks.md lacks \"${needle}\":\n${md}")

@@ -829,11 +829,15 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
     }
   }
 
-  // Every top-level number of the JSON (placements, seed, da, resolution...) as "key value".
+  // Every top-level number or flag of the JSON (placements, seed, da, resolution, exact_check...)
+  // as "key value".
   std::string settings;
   for (const auto& [key, value] : *json->object()) {
-    if (value.isNumber())
+    if (value.isNumber()) {
       settings += (settings.empty() ? "" : ", ") + key + " " + fmt(value.number());
+    } else if (const bool* flag = std::get_if<bool>(&value.v)) {
+      settings += (settings.empty() ? "" : ", ") + key + (*flag ? " on" : " off");
+    }
   }
   std::ostringstream md;
   md << "# Benchmarks: `autograsp-bench`\n\n"

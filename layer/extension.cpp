@@ -9,7 +9,7 @@
 #include "state.h"
 
 #if SDFG_LAYER_VULKAN
-#include "vk_grasp_backend.h"
+#include "vulkan/vk_grasp_backend.h"
 #endif
 
 namespace sdfg::layer {

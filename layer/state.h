@@ -14,8 +14,8 @@
 
 #include "config.h"
 #include "dispatch.h"
-#include "grasp_session.h"
-#include "hand_synthesis.h"
+#include "grasp/grasp_session.h"
+#include "hand/hand_synthesis.h"
 #include "xr_includes.h"
 
 namespace sdfg {

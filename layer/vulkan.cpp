@@ -21,8 +21,8 @@
 #include "state.h"
 
 #if SDFG_LAYER_VULKAN
-#include "vk_extra_queue.h"
-#include "vk_grasp_backend.h"
+#include "vulkan/vk_extra_queue.h"
+#include "vulkan/vk_grasp_backend.h"
 #endif
 
 namespace sdfg::layer {

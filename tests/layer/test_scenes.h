@@ -10,13 +10,13 @@
 #include <string>
 #include <vector>
 
-#include "hand_model.h"
-#include "hand_synthesis.h"
-#include "mesh.h"
-#include "mesh_distance.h"
-#include "mesh_io.h"
-#include "sdf_grid.h"
-#include "shapes.h"
+#include "hand/hand_model.h"
+#include "hand/hand_synthesis.h"
+#include "io/mesh_io.h"
+#include "io/shapes.h"
+#include "mesh/mesh.h"
+#include "mesh/mesh_distance.h"
+#include "sdf/sdf_grid.h"
 #include "test_support.h"
 
 namespace sdfg::test {

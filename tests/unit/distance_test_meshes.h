@@ -13,11 +13,11 @@
 
 #include <glm/geometric.hpp>
 
-#include "mesh.h"
-#include "mesh_io.h"
-#include "shapes.h"
+#include "io/mesh_io.h"
+#include "io/shapes.h"
+#include "mesh/mesh.h"
+#include "mesh/triangle_bvh.h"
 #include "test_support.h"
-#include "triangle_bvh.h"
 
 namespace sdfg::test {
 

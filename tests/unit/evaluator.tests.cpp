@@ -8,11 +8,11 @@
 #include <glm/geometric.hpp>
 #include <glm/gtx/quaternion.hpp>
 
-#include "evaluator.h"
-#include "hand_model.h"
-#include "mesh.h"
-#include "placements.h"
-#include "shapes.h"
+#include "eval/evaluator.h"
+#include "eval/placements.h"
+#include "hand/hand_model.h"
+#include "io/shapes.h"
+#include "mesh/mesh.h"
 
 using namespace sdfg;
 

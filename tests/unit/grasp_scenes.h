@@ -11,9 +11,9 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
-#include "hand_model.h"
-#include "mesh.h"
-#include "sdf_grid.h"
+#include "hand/hand_model.h"
+#include "mesh/mesh.h"
+#include "sdf/sdf_grid.h"
 
 namespace sdfg::test {
 

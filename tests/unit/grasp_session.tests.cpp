@@ -3,9 +3,9 @@
 // by a later update(); a device failure redoes the build on the CPU in the same update.
 #include <catch2/catch.hpp>
 
-#include "grasp_session.h"
-#include "sdf_cpu.h"
-#include "shapes.h"
+#include "grasp/grasp_session.h"
+#include "io/shapes.h"
+#include "sdf/sdf_cpu.h"
 
 namespace {
 

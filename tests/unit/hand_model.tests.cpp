@@ -12,7 +12,7 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "hand_model.h"
+#include "hand/hand_model.h"
 
 namespace {
 

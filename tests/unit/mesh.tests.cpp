@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "mesh.h"
+#include "mesh/mesh.h"
 
 namespace {
 

@@ -7,8 +7,8 @@
 #include <random>
 
 #include "distance_test_meshes.h"
-#include "mesh_distance.h"
-#include "triangle_bvh.h"
+#include "mesh/mesh_distance.h"
+#include "mesh/triangle_bvh.h"
 
 using namespace sdfg;
 using namespace sdfg::test;

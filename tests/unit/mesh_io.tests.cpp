@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "mesh_io.h"
+#include "io/mesh_io.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;

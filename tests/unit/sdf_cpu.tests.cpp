@@ -8,7 +8,7 @@
 #include <random>
 
 #include "distance_test_meshes.h"
-#include "sdf_cpu.h"
+#include "sdf/sdf_cpu.h"
 
 using namespace sdfg;
 using namespace sdfg::test;

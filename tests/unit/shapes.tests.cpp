@@ -10,7 +10,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "shapes.h"
+#include "io/shapes.h"
 
 namespace {
 

@@ -3,11 +3,11 @@
 
 #include <string>
 
-#include "solver.h"
+#include "eval/strategies.h"
 
 TEST_CASE("every listed solver name creates a solver of that name", "[solver]") {
   using namespace sdfg;
-  const std::vector<std::string> names = solverNames();
+  const std::vector<std::string> names = allSolverNames();
   REQUIRE(names.size() >= 4);
   CHECK(names[0] == "ours");  // the default
   CHECK(names[1] == "paper");
@@ -15,7 +15,7 @@ TEST_CASE("every listed solver name creates a solver of that name", "[solver]") 
   CHECK(names[3] == "physics-mesh");
   for (const std::string& name : names) {
     CAPTURE(name);
-    auto solver = createSolver(name);
+    auto solver = createAnySolver(name);
     REQUIRE(solver.ok());
     REQUIRE(solver.value() != nullptr);
     CHECK(solver.value()->name() == name);
@@ -25,11 +25,11 @@ TEST_CASE("every listed solver name creates a solver of that name", "[solver]") 
 
 TEST_CASE("an unknown solver name is an error that lists the known ones", "[solver]") {
   using namespace sdfg;
-  auto solver = createSolver("magic");
+  auto solver = createAnySolver("magic");
   REQUIRE_FALSE(solver.ok());
   CHECK(solver.error().code == Status::invalid_argument);
   CHECK(solver.error().message.find("magic") != std::string::npos);
-  for (const std::string& name : solverNames()) {
+  for (const std::string& name : allSolverNames()) {
     CHECK(solver.error().message.find(name) != std::string::npos);
   }
 }

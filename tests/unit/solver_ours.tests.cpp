@@ -13,13 +13,13 @@
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
 
-#include "grasp_holder.h"
-#include "hand_model.h"
-#include "mesh_distance.h"
-#include "sdf_grid.h"
-#include "shapes.h"
-#include "solver.h"
-#include "solver_ours.h"
+#include "grasp/grasp_holder.h"
+#include "grasp/solver.h"
+#include "grasp/solver_ours.h"
+#include "hand/hand_model.h"
+#include "io/shapes.h"
+#include "mesh/mesh_distance.h"
+#include "sdf/sdf_grid.h"
 
 namespace {
 

@@ -10,8 +10,8 @@
 #include <new>
 #include <vector>
 
+#include "grasp/solver_paper.h"
 #include "grasp_scenes.h"
-#include "solver_paper.h"
 
 // Counts every allocation of the test program, so a test can show that solve() makes none.
 namespace {

@@ -7,8 +7,8 @@
 #include <iostream>
 #include <limits>
 
+#include "eval/solver_physics.h"
 #include "grasp_scenes.h"
-#include "solver_physics.h"
 
 namespace {
 

@@ -3,7 +3,7 @@
 #include <memory>
 #include <string>
 
-#include "status.h"
+#include "base/status.h"
 
 TEST_CASE("Result holds either a value or an error", "[core][status]") {
   using sdfg::Result;

@@ -3,7 +3,7 @@
 // family with one queue is the case where nothing can be planned).
 #include <catch2/catch.hpp>
 
-#include "vk_extra_queue.h"
+#include "vulkan/vk_extra_queue.h"
 
 namespace {
 

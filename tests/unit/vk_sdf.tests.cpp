@@ -15,16 +15,16 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "mesh.h"
-#include "mesh_distance.h"
-#include "mesh_io.h"
-#include "sdf_cpu.h"
-#include "sdf_grid.h"
-#include "shapes.h"
+#include "io/mesh_io.h"
+#include "io/shapes.h"
+#include "mesh/mesh.h"
+#include "mesh/mesh_distance.h"
+#include "sdf/sdf_cpu.h"
+#include "sdf/sdf_grid.h"
 #include "test_support.h"
-#include "vk_sdf_backend.h"
-#include "vk_sdf_builder.h"
-#include "vk_standalone.h"
+#include "vulkan/vk_sdf_backend.h"
+#include "vulkan/vk_sdf_builder.h"
+#include "vulkan_device/vk_standalone.h"
 
 namespace {
 

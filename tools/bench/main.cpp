@@ -28,18 +28,19 @@
 #include <thread>
 #include <vector>
 
-#include "evaluator.h"
-#include "hand_model.h"
-#include "mesh.h"
-#include "mesh_distance.h"
-#include "mesh_io.h"
-#include "placements.h"
+#include "eval/evaluator.h"
+#include "eval/placements.h"
+#include "eval/solver_physics.h"
+#include "eval/strategies.h"
+#include "grasp/solver.h"
+#include "hand/hand_model.h"
+#include "io/mesh_io.h"
+#include "io/shapes.h"
+#include "mesh/mesh.h"
+#include "mesh/mesh_distance.h"
 #include "report.h"
+#include "sdf/sdf_grid.h"
 #include "sdf_backends.h"
-#include "sdf_grid.h"
-#include "shapes.h"
-#include "solver.h"
-#include "solver_physics.h"
 
 namespace fs = std::filesystem;
 using namespace sdfg;
@@ -128,7 +129,7 @@ bool parseInt(const std::string& s, long long lo, long long hi, long long& out) 
 }
 
 std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& help) {
-  const std::vector<std::string> known = solverNames();
+  const std::vector<std::string> known = allSolverNames();
   for (int i = 1; i < argc; ++i) {
     std::string arg = argv[i];
     std::string value;
@@ -454,7 +455,7 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
   SolverOptions solverOptions;
   solverOptions.da = o.da;
   for (const std::string& m : o.methods) {
-    auto solver = createSolver(m);
+    auto solver = createAnySolver(m);
     if (!solver) return solver.error();
     if (Status s = (*solver)->prepare(hand, box, solverOptions); s != Status::ok) {
       return makeError(s, m + ": prepare failed: " + std::string((*solver)->prepareError()));

@@ -14,12 +14,12 @@
 #include <tuple>
 #include <variant>
 
-#include "evaluator.h"
-#include "hand_model.h"
-#include "mesh_io.h"
-#include "placements.h"
-#include "sdf_cpu.h"
-#include "shapes.h"
+#include "eval/evaluator.h"
+#include "eval/placements.h"
+#include "hand/hand_model.h"
+#include "io/mesh_io.h"
+#include "io/shapes.h"
+#include "sdf/sdf_cpu.h"
 
 namespace fs = std::filesystem;
 

@@ -19,12 +19,12 @@
 #include <string>
 #include <vector>
 
-#include "mesh.h"
-#include "mesh_distance.h"
-#include "pose.h"
+#include "base/pose.h"
+#include "base/status.h"
+#include "mesh/mesh.h"
+#include "mesh/mesh_distance.h"
+#include "sdf/sdf_grid.h"
 #include "sdf_backends.h"
-#include "sdf_grid.h"
-#include "status.h"
 
 namespace sdfg::bench {
 

@@ -4,13 +4,13 @@
 #include <cmath>
 #include <thread>
 
-#include "mesh_io.h"
-#include "sdf_cpu.h"
-#include "shapes.h"
+#include "io/mesh_io.h"
+#include "io/shapes.h"
+#include "sdf/sdf_cpu.h"
 
 #ifdef SDFG_TOOLS_HAVE_VULKAN
-#include "vk_sdf_builder.h"
-#include "vk_standalone.h"
+#include "vulkan/vk_sdf_builder.h"
+#include "vulkan_device/vk_standalone.h"
 #endif
 
 namespace sdfg::tools {

@@ -21,11 +21,11 @@
 
 #include <glm/vec3.hpp>
 
-#include "mesh.h"
-#include "mesh_distance.h"
-#include "pose.h"
-#include "sdf_grid.h"
-#include "status.h"
+#include "base/pose.h"
+#include "base/status.h"
+#include "mesh/mesh.h"
+#include "mesh/mesh_distance.h"
+#include "sdf/sdf_grid.h"
 
 namespace sdfg::tools {
 

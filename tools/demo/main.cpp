@@ -17,16 +17,17 @@
 #include <vector>
 
 #include "demo_config.h"
-#include "hand_synthesis.h"
-#include "mesh_io.h"
+#include "eval/solver_physics.h"
+#include "eval/strategies.h"
+#include "grasp/solver.h"
+#include "hand/hand_synthesis.h"
+#include "io/mesh_io.h"
+#include "io/shapes.h"
 #include "png_io.h"
 #include "renderer.h"
 #include "report.h"
 #include "scene.h"
-#include "sdf_cpu.h"
-#include "shapes.h"
-#include "solver.h"
-#include "solver_physics.h"
+#include "sdf/sdf_cpu.h"
 #include "xr_app.h"
 
 namespace fs = std::filesystem;
@@ -362,7 +363,7 @@ int main(int argc, char** argv) {
     phys.name = "physics-convex";
     phys.source = "core";
     {
-      auto solver = createSolver("physics-convex");
+      auto solver = createAnySolver("physics-convex");
       auto collider = PhysicsCollider::create(c.mesh, PhysicsCollider::Kind::convexHull);
       GraspResult gr;
       Status st = Status::ok;

@@ -8,7 +8,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat3x3.hpp>
 
-#include "hand_synthesis.h"
+#include "hand/hand_synthesis.h"
 
 namespace sdfg::demo {
 namespace {

@@ -11,12 +11,12 @@
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
-#include "hand_model.h"
-#include "mesh.h"
-#include "mesh_distance.h"
-#include "pose.h"
+#include "base/pose.h"
+#include "hand/hand_model.h"
+#include "mesh/mesh.h"
+#include "mesh/mesh_distance.h"
 #include "renderer.h"
-#include "sdf_grid.h"
+#include "sdf/sdf_grid.h"
 
 namespace sdfg::demo {
 

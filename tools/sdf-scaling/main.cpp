@@ -29,9 +29,9 @@
 #include <string>
 #include <vector>
 
-#include "mesh_distance.h"
+#include "mesh/mesh_distance.h"
+#include "sdf/sdf_grid.h"
 #include "sdf_backends.h"
-#include "sdf_grid.h"
 
 namespace {
 

@@ -1,0 +1,319 @@
+#include "grasp/grasp_session.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace sdfg {
+namespace {
+
+// Finite, and min <= max on every axis (a flat box is fine).
+bool validBounds(const Aabb& bounds) {
+  for (int a = 0; a < 3; ++a) {
+    if (!std::isfinite(bounds.min[a]) || !std::isfinite(bounds.max[a]) ||
+        !(bounds.min[a] <= bounds.max[a]))
+      return false;
+  }
+  return true;
+}
+
+float angleBetween(const glm::quat& a, const glm::quat& b) {
+  const float d = std::min(1.0f, std::abs(glm::dot(a, b)));
+  return 2.0f * std::acos(d);
+}
+
+}  // namespace
+
+std::optional<Error> GraspSettings::validate() const {
+  if (auto e = box.validate()) return e;
+  if (!(grabThreshold > 0.0f && grabThreshold <= 1.0f))
+    return makeError(Status::invalid_argument, "grasp settings: grabThreshold must be in (0, 1]");
+  if (!(releaseRatio >= 0.0f && releaseRatio <= 1.0f))
+    return makeError(Status::invalid_argument, "grasp settings: releaseRatio must be in [0, 1]");
+  if (!(moveTolerance >= 0.0f) || !(turnTolerance >= 0.0f))
+    return makeError(Status::invalid_argument, "grasp settings: tolerances must be >= 0");
+  return std::nullopt;
+}
+
+GraspSession::GraspSession(std::unique_ptr<SdfBackend> backend,
+                           std::unique_ptr<DeferredSdfBackend> deferred)
+    : backend_(std::move(backend)), deferred_(std::move(deferred)) {
+  hands_[0].model = HandModel::defaultAdult(Hand::left);
+  hands_[1].model = HandModel::defaultAdult(Hand::right);
+  (void)configure(settings_);
+}
+
+GraspSession::~GraspSession() = default;
+
+Status GraspSession::configure(const GraspSettings& settings) {
+  if (settings.validate()) return Status::invalid_argument;
+  std::array<std::unique_ptr<GraspSolver>, 2> solvers;
+  for (auto& s : solvers) {
+    auto made = createSolver(settings.solver);
+    if (!made) return made.error().code;
+    if (!(*made)->needsField() || (*made)->needsCollider()) return Status::unsupported;
+    s = std::move(*made);
+  }
+  settings_ = settings;
+  for (size_t h = 0; h < 2; ++h) {
+    // A build in flight was made for the old box: drop it, a held hand asks again.
+    cancelPending(hands_[h], h);
+    hands_[h].solver = std::move(solvers[h]);
+    hands_[h].prepared = false;
+  }
+  return Status::ok;
+}
+
+Status GraspSession::addTarget(uint64_t id, const TriangleMesh& mesh) {
+  if (targets_.count(id) != 0) return Status::invalid_argument;
+  auto distance = MeshDistance::create(mesh);
+  if (!distance) return distance.error().code;
+  Target t;
+  t.bounds = computeBounds(mesh.positions);
+  t.distance = std::move(*distance);
+  targets_.emplace(id, std::move(t));
+  return Status::ok;
+}
+
+Status GraspSession::addDeviceTarget(uint64_t id, const Aabb& bounds) {
+  if (targets_.count(id) != 0) return Status::invalid_argument;
+  if (!validBounds(bounds)) return Status::invalid_argument;
+  if (!deferredUsable() || !deferred_->hasDeviceMesh(id)) return Status::unsupported;
+  Target t;
+  t.bounds = bounds;
+  targets_.emplace(id, std::move(t));
+  return Status::ok;
+}
+
+Status GraspSession::updateTargetBounds(uint64_t id, const Aabb& bounds) {
+  auto it = targets_.find(id);
+  if (it == targets_.end() || it->second.distance != nullptr) return Status::invalid_argument;
+  if (!validBounds(bounds)) return Status::invalid_argument;
+  it->second.bounds = bounds;
+  return Status::ok;
+}
+
+Status GraspSession::touchTarget(uint64_t id) {
+  auto it = targets_.find(id);
+  if (it == targets_.end()) return Status::invalid_argument;
+  ++it->second.version;
+  return Status::ok;
+}
+
+Status GraspSession::submitDeferred(bool sharedQueueFree) {
+  if (!deferredUsable()) return Status::ok;
+  const Status s = deferred_->submit(sharedQueueFree);
+  if (deferred_->failed()) stats_.gpuFailed = true;
+  return s;
+}
+
+void GraspSession::dropDeferred() {
+  for (size_t h = 0; h < 2; ++h) hands_[h].pending = false;
+  deferred_.reset();
+}
+
+void GraspSession::cancelPending(HandState& hand, size_t slot) {
+  if (hand.pending && deferred_ != nullptr) deferred_->cancel(slot);
+  hand.pending = false;
+}
+
+Status GraspSession::updateTargetVertices(uint64_t id, std::span<const glm::vec3> positions) {
+  auto it = targets_.find(id);
+  if (it == targets_.end() || it->second.distance == nullptr) return Status::invalid_argument;
+  if (Status s = it->second.distance->updatePositions(positions); s != Status::ok) return s;
+  it->second.bounds = computeBounds(positions);
+  ++it->second.version;
+  return Status::ok;
+}
+
+bool GraspSession::removeTarget(uint64_t id) {
+  for (size_t h = 0; h < 2; ++h) {
+    if (hands_[h].grasp.holding && hands_[h].grasp.target == id) {
+      cancelPending(hands_[h], h);
+      hands_[h].grasp = HandGrasp{};
+    }
+  }
+  return targets_.erase(id) != 0;
+}
+
+void GraspSession::release(Hand hand) {
+  cancelPending(hands_[size_t(hand)], size_t(hand));
+  hands_[size_t(hand)].grasp = HandGrasp{};
+}
+
+std::optional<uint64_t> GraspSession::pickTarget(const Pose& worldFromWrist,
+                                                 std::span<const TargetFrame> targets) const {
+  const GridBox& box = settings_.box;
+  const Pose boxFromWorld = (worldFromWrist * box.handFromBox).inverse();
+  const glm::vec3 half = box.size * 0.5f;
+  std::optional<uint64_t> best;
+  float bestDistance = std::numeric_limits<float>::infinity();
+  for (const TargetFrame& t : targets) {
+    auto it = targets_.find(t.id);
+    if (!t.valid || it == targets_.end()) continue;
+    const Pose boxFromObject = boxFromWorld * t.worldFromObject;
+    // The target's bounds, as a box-space AABB of its 8 corners, must overlap the grab box.
+    glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
+    for (int c = 0; c < 8; ++c) {
+      const glm::vec3 corner((c & 1) ? it->second.bounds.max.x : it->second.bounds.min.x,
+                             (c & 2) ? it->second.bounds.max.y : it->second.bounds.min.y,
+                             (c & 4) ? it->second.bounds.max.z : it->second.bounds.min.z);
+      const glm::vec3 p = boxFromObject.transformPoint(corner);
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+    if (glm::any(glm::greaterThan(lo, half)) || glm::any(glm::lessThan(hi, -half))) continue;
+    const float d = glm::length(boxFromObject.transformPoint(it->second.bounds.center()));
+    if (d < bestDistance) bestDistance = d, best = t.id;
+  }
+  return best;
+}
+
+Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Target& target,
+                           const Pose& objectFromHand) {
+  if (!hand.prepared) {
+    if (Status s = hand.solver->prepare(hand.model, settings_.box, settings_.solverOptions);
+        s != Status::ok)
+      return s;
+    hand.prepared = true;
+  }
+  if (deferredUsable() && (target.distance == nullptr || deferredForMeshTargets_)) {
+    const TriangleMesh* mesh = target.distance ? &target.distance->mesh() : nullptr;
+    const Status s =
+        deferred_->request(slot, id, target.version, mesh, objectFromHand, settings_.box);
+    if (s == Status::ok) {
+      hand.pending = true;
+      hand.pendingPose = objectFromHand;
+      hand.pendingVersion = target.version;
+      return Status::ok;
+    }
+    // Busy with a cancelled build still on the device: ask again at the next update.
+    if (s == Status::unsupported) return Status::ok;
+    if (s == Status::invalid_argument) return s;
+    stats_.gpuFailed = true;  // the device failed: this and every later build on the CPU
+  }
+  if (target.distance == nullptr) return Status::device_lost;
+  if (Status s = backend_->build(*target.distance, objectFromHand, settings_.box, hand.grid);
+      s != Status::ok)
+    return s;
+  ++stats_.cpuBuilds;
+  return solveWithGrid(hand, objectFromHand, target.version, false, target.distance.get());
+}
+
+Status GraspSession::solveWithGrid(HandState& hand, const Pose& objectFromHand, uint64_t version,
+                                   bool gpu, const MeshDistance* exactMesh) {
+  GraspScene scene;
+  scene.field = &hand.grid;
+  scene.objectFromHand = objectFromHand;
+  std::optional<MeshExactSource> exact;
+  if (settings_.exactCheck && exactMesh != nullptr) {
+    exact.emplace(*exactMesh, objectFromHand);
+    scene.exact = &*exact;
+  }
+  GraspResult result;
+  if (Status s = hand.solver->solve(scene, result); s != Status::ok) return s;
+  hand.grasp.result = result;
+  hand.grasp.objectFromHand = objectFromHand;
+  hand.grasp.builtOnGpu = gpu;
+  hand.solvedVersion = version;
+  ++hand.grasp.solves;
+  return Status::ok;
+}
+
+Status GraspSession::collect(HandState& hand, size_t slot) {
+  if (!hand.pending) return Status::ok;
+  if (deferred_ == nullptr) {
+    hand.pending = false;
+    return Status::ok;
+  }
+  const BuildPoll p = deferred_->poll(slot, hand.grid);
+  if (p == BuildPoll::pending) return Status::ok;
+  hand.pending = false;
+  auto it = hand.grasp.holding ? targets_.find(hand.grasp.target) : targets_.end();
+  if (it == targets_.end()) return Status::ok;
+  if (p == BuildPoll::ready) {
+    ++stats_.gpuBuilds;
+    // A result for older vertices is still shown; the next update asks again.
+    return solveWithGrid(hand, hand.pendingPose, hand.pendingVersion, true,
+                         it->second.distance.get());
+  }
+  // The device failed (or lost the request): redo the build on the CPU now.
+  if (p == BuildPoll::failed) stats_.gpuFailed = true;
+  if (it->second.distance == nullptr) {
+    hand.grasp = HandGrasp{};
+    return Status::device_lost;
+  }
+  if (Status s = backend_->build(*it->second.distance, hand.pendingPose, settings_.box, hand.grid);
+      s != Status::ok) {
+    hand.grasp = HandGrasp{};
+    return s;
+  }
+  ++stats_.cpuBuilds;
+  return solveWithGrid(hand, hand.pendingPose, hand.pendingVersion, false,
+                       it->second.distance.get());
+}
+
+Status GraspSession::update(Hand side, const HandFrame& frame,
+                            std::span<const TargetFrame> targets) {
+  const size_t slot = size_t(side);
+  HandState& hand = hands_[slot];
+  hand.squeeze = std::isfinite(frame.squeeze) ? frame.squeeze : 0.0f;
+  const Status collected = collect(hand, slot);
+  if (hand.grasp.holding) {
+    auto it = targets_.find(hand.grasp.target);
+    if (it == targets_.end() || hand.squeeze < settings_.grabThreshold * settings_.releaseRatio) {
+      cancelPending(hand, slot);
+      hand.grasp = HandGrasp{};
+      return collected;
+    }
+    const TargetFrame* located = nullptr;
+    for (const TargetFrame& t : targets) {
+      if (t.id == hand.grasp.target && t.valid) located = &t;
+    }
+    if (!frame.valid || located == nullptr) return collected;  // keep the last solve
+    if (hand.pending) return collected;  // the build in flight first, then re-check
+    const Pose objectFromHand = located->worldFromObject.inverse() * frame.worldFromWrist;
+    const bool moved =
+        glm::length(objectFromHand.position - hand.grasp.objectFromHand.position) >
+            settings_.moveTolerance ||
+        angleBetween(objectFromHand.orientation, hand.grasp.objectFromHand.orientation) >
+            settings_.turnTolerance;
+    if (hand.grasp.solves > 0 && !moved && hand.solvedVersion == it->second.version)
+      return collected;
+    const Status s = solve(hand, slot, it->first, it->second, objectFromHand);
+    if (s != Status::ok) {
+      cancelPending(hand, slot);
+      hand.grasp = HandGrasp{};
+    }
+    return s;
+  }
+
+  if (!frame.valid || hand.squeeze < settings_.grabThreshold) return collected;
+  const std::optional<uint64_t> id = pickTarget(frame.worldFromWrist, targets);
+  if (!id) return collected;
+  const Target& target = targets_.at(*id);
+  const TargetFrame* located = nullptr;
+  for (const TargetFrame& t : targets) {
+    if (t.id == *id) located = &t;
+  }
+  // A tracked hand brings its own bone lengths: fit the model to it at the start of the grab.
+  if (frame.trackedJoints != nullptr && frame.trackedRadii != nullptr) {
+    auto fitted = HandModel::fitToJoints(side, *frame.trackedJoints, *frame.trackedRadii);
+    if (fitted) {
+      hand.model = std::move(*fitted);
+      hand.prepared = false;
+    }
+  }
+  hand.grasp = HandGrasp{};
+  hand.grasp.holding = true;
+  hand.grasp.target = *id;
+  const Status s =
+      solve(hand, slot, *id, target, located->worldFromObject.inverse() * frame.worldFromWrist);
+  if (s != Status::ok) {
+    cancelPending(hand, slot);
+    hand.grasp = HandGrasp{};
+  }
+  return s;
+}
+
+}  // namespace sdfg

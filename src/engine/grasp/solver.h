@@ -1,0 +1,146 @@
+// The grasp solver interface: given where the target is relative to the hand, find how far each
+// finger closes before it touches.
+//
+// Strategies ("paper", "physics-convex", "physics-mesh", later "ours") implement GraspSolver.
+// Callers create one by name, prepare() it once per hand model and box (that is where curve
+// caches are built), then call solve() per grasp. A strategy says which representation of the
+// target it reads: the grab-box SDF, or a Bullet collider.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "base/pose.h"
+#include "base/status.h"
+#include "hand/hand_model.h"
+#include "sdf/sdf_grid.h"
+
+namespace sdfg {
+
+class PhysicsCollider;  // solver_physics.h
+class MeshDistance;     // mesh_distance.h
+
+struct SolverOptions {
+  float da = 0.1f;           // curl step along each finger's curve, in (0, 1]
+  float threshold = -1.0f;   // stop distance in metres; < 0: each finger's tip radius
+  float refineStep = 0.01f;  // physics strategies: the fine step after the coarse one
+  bool approach = false;     // "ours": move the hand onto the surface first (approachPose)
+};
+
+struct FingerState {
+  float curl = 0.0f;        // overall curl of the finger (its tip's curve parameter)
+  JointCurls jointCurls{};  // per joint; all equal to `curl` for single-curl strategies
+  bool contact = false;     // stopped on the surface (false: closed fully without touching)
+  glm::vec3 contactPoint{
+      0.0f};              // hand space: where the finger touches (the stopping sphere's centre)
+  float distance = 0.0f;  // the target's distance at contactPoint as the strategy saw it
+};
+
+struct GraspResult {
+  std::array<FingerState, kFingerCount> fingers{};
+  // Where the strategy moved the hand before closing it (SolverOptions::approach): maps the
+  // corrected hand frame, in which the fingers and contact points are, into the scene's hand
+  // frame. Identity for every strategy that leaves the hand where it is.
+  Pose handCorrection{};
+  // Strategies that check their stops on GraspScene::exact ("ours"): points sampled there and
+  // the wall time of that check (included in the solve), microseconds. 0 without a source.
+  int exactSamples = 0;
+  float exactCheckUs = 0.0f;
+};
+
+// One exact sample of the target's distance (ExactDistanceSource).
+struct ExactSample {
+  // Signed, metres, negative inside; +infinity when no surface is within the search distance
+  // (then the side is unknown and `closest` is not set).
+  float distance = std::numeric_limits<float>::infinity();
+  glm::vec3 closest{0.0f};  // closest surface point, in the frame of the query point
+  // Source-specific id of the closest feature (MeshExactSource: the triangle), or max() when
+  // none was found. On entry to sample() it is a hint: the id an earlier sample of a point near
+  // this one returned (max(): none), which may make the search cheaper; it never changes the
+  // result.
+  uint32_t feature = std::numeric_limits<uint32_t>::max();
+};
+
+// Exact distance to the target at a few points, for strategies that check the stops they found
+// on the sampled field ("ours"): the field's error at 16^3 is millimetres near curved and sharp
+// parts. An interface so that a GPU path can answer a batch at once; MeshExactSource answers on
+// the CPU from a MeshDistance.
+class ExactDistanceSource {
+ public:
+  virtual ~ExactDistanceSource() = default;
+  // For each i: out[i] is the exact sample of handPoints[i] (scene hand frame) searched within
+  // maxDistances[i] metres (a small bound keeps the search cheap). The three spans must have the
+  // same size; the caller owns them. out[i].feature on entry is a hint (see ExactSample). Must be
+  // safe to call from several threads at once.
+  virtual void sample(std::span<const glm::vec3> handPoints, std::span<const float> maxDistances,
+                      std::span<ExactSample> out) const = 0;
+};
+
+// ExactDistanceSource over a MeshDistance of the target in object space: hand-space points are
+// mapped by objectFromHand. Keeps a reference to `mesh` (the caller keeps it alive and does not
+// update it while solves run). The sign is MeshDistance::localSignedDistanceWithin's (the side
+// of the nearest sheet, also on open meshes).
+class MeshExactSource final : public ExactDistanceSource {
+ public:
+  MeshExactSource(const MeshDistance& mesh, const Pose& objectFromHand);
+  void sample(std::span<const glm::vec3> handPoints, std::span<const float> maxDistances,
+              std::span<ExactSample> out) const override;
+
+ private:
+  const MeshDistance* mesh_;
+  Pose objectFromHand_;
+  Pose handFromObject_;
+};
+
+// The target as the solvers see it. Only the representation a strategy asks for must be set.
+struct GraspScene {
+  const SdfGrid* field = nullptr;             // SDF of the target in the grab box (hand space)
+  const PhysicsCollider* collider = nullptr;  // Bullet collider of the target (object space)
+  Pose objectFromHand;                        // hand-space point -> object space
+  // Optional exact distance of the same target (scene hand frame). "ours" checks and corrects
+  // its stops with it; null: the field alone, as before. Other strategies ignore it.
+  const ExactDistanceSource* exact = nullptr;
+};
+
+class GraspSolver {
+ public:
+  virtual ~GraspSolver() = default;
+
+  virtual std::string_view name() const = 0;
+  virtual bool needsField() const = 0;
+  virtual bool needsCollider() const = 0;
+
+  // Caches what depends only on the hand model, the box and the options (the finger curves in
+  // box coordinates). Call again when any of them changes. Fails on invalid options.
+  virtual Status prepare(const HandModel& hand, const GridBox& box,
+                         const SolverOptions& options) = 0;
+
+  // Solves one grasp into `out`. Fails when not prepared or when the scene lacks what
+  // needsField()/needsCollider() ask for. Never allocates for the SDF strategies.
+  virtual Status solve(const GraspScene& scene, GraspResult& out) const = 0;
+
+  // Why the last prepare() failed, naming the option or input; empty after a successful one.
+  virtual std::string_view prepareError() const { return {}; }
+};
+
+// Checks the options every strategy shares: da and refineStep finite and in (0, 1], threshold
+// finite (negative means "the finger's tip radius"). Returns the first problem, or nothing.
+std::optional<Error> validateSolverOptions(const SolverOptions& options);
+
+// Names accepted by createSolver(): the strategies that run in an app ("ours", the default, then
+// "paper"). The benchmark's full list, with the physics baselines, is eval/strategies.h.
+std::vector<std::string> solverNames();
+
+// Creates a strategy by name; an unknown name is an invalid_argument error listing the known ones.
+Result<std::unique_ptr<GraspSolver>> createSolver(std::string_view name);
+
+}  // namespace sdfg

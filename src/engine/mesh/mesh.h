@@ -1,0 +1,57 @@
+// Triangle meshes as the core takes them: positions and 32-bit indices, validated once.
+//
+// Every mesh that reaches the SDF builders or solvers went through makeMesh(), so they may
+// assume finite positions, indices in range, and no degenerate triangles. Units are metres.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "base/pose.h"
+#include "base/status.h"
+
+namespace sdfg {
+
+struct TriangleMesh {
+  std::vector<glm::vec3> positions;
+  std::vector<uint32_t> indices;  // three per triangle, counter-clockwise seen from outside
+
+  size_t vertexCount() const { return positions.size(); }
+  size_t triangleCount() const { return indices.size() / 3; }
+};
+
+struct Aabb {
+  glm::vec3 min{0.0f};
+  glm::vec3 max{0.0f};
+  glm::vec3 center() const { return (min + max) * 0.5f; }
+  glm::vec3 extent() const { return max - min; }
+};
+
+// Checks arrays before anything is built. Returns the first problem found, naming the element:
+// empty mesh, index count not a multiple of 3, NaN or infinite coordinate, index out of range,
+// degenerate triangle (two equal indices, or zero area). Returns nothing when the mesh is valid.
+std::optional<Error> validateMesh(std::span<const glm::vec3> positions,
+                                  std::span<const uint32_t> indices);
+
+// Validates and copies the arrays into a mesh. Nothing is built when validation fails.
+Result<TriangleMesh> makeMesh(std::span<const glm::vec3> positions,
+                              std::span<const uint32_t> indices);
+
+// Same, from interleaved float xyz triples (positions.size() must be a multiple of 3).
+Result<TriangleMesh> makeMesh(std::span<const float> xyz, std::span<const uint32_t> indices);
+
+Aabb computeBounds(std::span<const glm::vec3> positions);
+
+// Applies parent = pose * (scale * p) to every vertex.
+void transformMesh(TriangleMesh& mesh, const Pose& pose, float scale = 1.0f);
+
+// Returns a copy scaled uniformly so the bounding-box diagonal equals `diagonal` metres and
+// centred on the origin (the benchmark scales every object to hand size this way).
+TriangleMesh normalizedToDiagonal(const TriangleMesh& mesh, float diagonal);
+
+}  // namespace sdfg

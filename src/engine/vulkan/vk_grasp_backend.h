@@ -1,0 +1,111 @@
+// The grab-box SDF of a grasp session on a borrowed Vulkan device (the OpenXR app's), behind
+// DeferredSdfBackend: one VkSdfBuilder per slot (hand), the grid read back through a fence that
+// poll() checks without waiting. Targets come as CPU arrays (from GraspSession) or as the app's
+// own Vulkan buffers, registered here by id and read by the GPU at every build (skinned meshes).
+//
+// Queues: submit() is the only call that touches a queue (vkQueueSubmit). Builds go to the
+// app's queue (the binding's; the caller passes sharedQueueFree only inside xrBeginFrame /
+// xrEndFrame), or, when the layer added a queue of its own to the app's device (`ownQueue`), CPU
+// targets' builds go there at any time. Builds of app-buffer targets always use the app's
+// queue: the app's writes to its buffers are ordered before them by submission order on that
+// queue, which a second queue would need a semaphore for. Everything else (request, poll,
+// cancel, destruction) uses device-level calls on objects this backend owns, or fences.
+//
+// Failure: the first Vulkan error (VK_ERROR_DEVICE_LOST included) logs one line through
+// options.log, marks the backend failed, and every later call answers failed / device_lost; the
+// session continues on the CPU. Destruction waits (at most 2 s per slot) for work in flight, so
+// the app may destroy its device and buffers afterwards.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <unordered_map>
+
+#include "sdf/sdf_backend.h"
+#include "vulkan/vk_sdf_builder.h"
+
+namespace sdfg {
+
+struct VkGraspBackendOptions {
+  // Where the one failure line goes (stderr when empty).
+  std::function<void(const std::string&)> log;
+};
+
+// Test hooks: a simulated VK_ERROR_DEVICE_LOST at the first submission, or at the poll after it
+// (the real work then still runs, so destruction must wait for it).
+enum class VkGraspFault { none, lostAtSubmit, lostAtPoll };
+
+class VkGraspBackend final : public DeferredSdfBackend {
+ public:
+  // Builds one VkSdfBuilder per slot on `appQueue` (pipelines included: do this outside the
+  // frame loop), or on `ownQueue` when given (then app-queue builders are made at the first
+  // setDeviceMesh). Errors: those of VkSdfBuilder::create.
+  static Result<std::unique_ptr<VkGraspBackend>> create(const VulkanDevice& appQueue,
+                                                        const VulkanDevice* ownQueue = nullptr,
+                                                        const VkGraspBackendOptions& options = {});
+  ~VkGraspBackend() override;
+
+  std::string_view name() const override { return "vulkan"; }
+  Status request(size_t slot, uint64_t id, uint64_t version, const TriangleMesh* mesh,
+                 const Pose& objectFromHand, const GridBox& box) override;
+  bool hasDeviceMesh(uint64_t id) const override { return deviceMeshes_.count(id) != 0; }
+  bool needsSubmit(bool sharedQueueFree) const override;
+  Status submit(bool sharedQueueFree) override;
+  BuildPoll poll(size_t slot, SdfGrid& out) override;
+  void cancel(size_t slot) override;
+  bool failed() const override { return failed_; }
+
+  // Registers (or replaces) the app-buffer mesh of target `id`. The buffers are borrowed: see
+  // VkMeshBuffers. Errors: invalid_argument (see VkSdfBuilder::setMesh(VkMeshBuffers)),
+  // device_lost (failed), or those of VkSdfBuilder::create (app-queue builders made here).
+  Status setDeviceMesh(uint64_t id, const VkMeshBuffers& buffers);
+  // Forgets the mesh of `id`; first waits (at most 2 s) for a build in flight that reads its
+  // buffers, so the app may destroy them when this returns.
+  void removeDeviceMesh(uint64_t id);
+
+  void injectFault(VkGraspFault fault) { fault_ = fault; }
+  // Whether CPU targets build on a queue of the layer's own.
+  bool hasOwnQueue() const { return ownQueue_; }
+
+ private:
+  struct Builder {
+    std::unique_ptr<VkSdfBuilder> builder;
+    bool shared = true;   // on the app's queue
+    uint64_t meshId = 0;  // the mesh set on the builder (0: none)
+    uint64_t meshVersion = 0;
+    bool meshOnDevice = false;
+  };
+  struct Slot {
+    Builder main;               // own queue when there is one, else the app's
+    Builder app;                // app-buffer targets when `main` is on the own queue
+    Builder* active = nullptr;  // the builder of the recorded or running build
+    bool recorded = false;      // waits for submit()
+    bool inFlight = false;      // submitted, fence not yet seen
+    bool discard = false;       // cancelled while in flight
+    GridBox box{};
+    Pose objectFromHand{};
+  };
+  struct DeviceMesh {
+    VkMeshBuffers buffers;
+    uint64_t version = 1;
+  };
+
+  VkGraspBackend() = default;
+  Status markFailed(Status status);
+  void logOnce(const std::string& line);
+  Result<std::unique_ptr<VkSdfBuilder>> makeBuilder(const VulkanDevice& device);
+
+  std::array<Slot, kSlots> slots_;
+  VulkanDevice appQueue_{};
+  bool ownQueue_ = false;
+  std::unordered_map<uint64_t, DeviceMesh> deviceMeshes_;
+  VkGraspBackendOptions options_;
+  VkGraspFault fault_ = VkGraspFault::none;
+  bool failed_ = false;
+  bool logged_ = false;
+};
+
+}  // namespace sdfg

@@ -273,17 +273,20 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
   } else {
     md << "## What is measured\n\n"
        << "Every mesh is scaled to an 18 cm bounding-box diagonal (hand size). Seeded hand "
-          "placements (`src/placements.h`) put the open palm 1 to 4 cm from a random surface "
+          "placements (`src/offline/eval/placements.h`) put the open palm 1 to 4 cm from a random "
+          "surface "
           "point; every method solves the same placements. `solve_us`: per-solve time, minimum "
           "over repeated batches, SDF build not included (as in the paper's Table 1). "
           "`sdf_build_ms`: the grab-box SDF build per placement on the row's `sdf_backend` (CPU, "
           "or Vulkan until its fence signals and the grid is read back), for the methods that "
           "read a field. Quality is graded against CGAL's exact distance to the original surface "
-          "(`src/evaluator.h`): `tip_residual_mm` |d(tip) - r_tip| over fingers in contact; "
+          "(`src/offline/eval/evaluator.h`): `tip_residual_mm` |d(tip) - r_tip| over fingers in "
+          "contact; "
           "`penetration_mm` deepest phalanx point inside the mesh per grasp; `early_stops` "
           "fingers (summed over grasps) that stopped more than 5 mm short of a reachable pose; "
           "`contacts_mean` fingers within 2 mm per grasp. Any other column is a metric of the "
-          "JSON documented in `src/evaluator.h`. `-`: no data (e.g. no finger in contact, no "
+          "JSON documented in `src/offline/eval/evaluator.h`. `-`: no data (e.g. no finger in "
+          "contact, no "
           "field for a physics method).\n\n";
   }
 

@@ -362,8 +362,8 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
     info->graspBackend = !held          ? XR_GRASP_SDF_BACKEND_NONE_SDFG
                          : g.builtOnGpu ? XR_GRASP_SDF_BACKEND_VULKAN_SDFG
                                         : XR_GRASP_SDF_BACKEND_CPU_SDFG;
-    info->sessionBackend = s->grasp->deferredUsable() ? XR_GRASP_SDF_BACKEND_VULKAN_SDFG
-                                                      : XR_GRASP_SDF_BACKEND_CPU_SDFG;
+    info->sessionBackend = s->grasp->deferredReady() ? XR_GRASP_SDF_BACKEND_VULKAN_SDFG
+                                                     : XR_GRASP_SDF_BACKEND_CPU_SDFG;
     info->gpuBuildCount = st.gpuBuilds;
     info->cpuBuildCount = st.cpuBuilds;
     info->gpuFailed = st.gpuFailed ? XR_TRUE : XR_FALSE;

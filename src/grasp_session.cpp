@@ -128,6 +128,13 @@ Status GraspSession::submitDeferred(bool sharedQueueFree) {
   return s;
 }
 
+bool GraspSession::deferredReady() {
+  if (deferred_ == nullptr) return false;
+  const bool ready = !deferred_->failed() && deferred_->ready();
+  if (deferred_->failed()) stats_.gpuFailed = true;  // its preparation failed
+  return ready;
+}
+
 void GraspSession::dropDeferred() {
   for (size_t h = 0; h < 2; ++h) hands_[h].pending = false;
   deferred_.reset();
@@ -198,7 +205,12 @@ Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Targ
       return s;
     hand.prepared = true;
   }
-  if (deferredUsable() && (target.distance == nullptr || deferredForMeshTargets_)) {
+  if (deferredUsable() && (target.distance == nullptr || deferredForMeshTargets_) &&
+      !deferredReady()) {
+    // Still preparing: a device target waits for it (asked again at the next update); a target
+    // with a CPU mesh is built on the CPU below rather than keep the hand waiting.
+    if (target.distance == nullptr && deferredUsable()) return Status::ok;
+  } else if (deferredUsable() && (target.distance == nullptr || deferredForMeshTargets_)) {
     const TriangleMesh* mesh = target.distance ? &target.distance->mesh() : nullptr;
     const Status s =
         deferred_->request(slot, id, target.version, mesh, objectFromHand, settings_.box);

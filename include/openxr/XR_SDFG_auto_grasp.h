@@ -168,10 +168,13 @@ typedef enum XrGraspSdfBackendSDFG {
 typedef struct XrGraspBuildInfoSDFG {
   XrStructureType type;  // XR_TYPE_GRASP_BUILD_INFO_SDFG
   void* XR_MAY_ALIAS next;
-  XrGraspSdfBackendSDFG graspBackend;    // of the hand's shown grasp; NONE when not grasping
-  XrGraspSdfBackendSDFG sessionBackend;  // where the session's next build goes
-  uint64_t gpuBuildCount;                // builds of the session done on the GPU so far
-  uint64_t cpuBuildCount;                // and on the CPU
+  XrGraspSdfBackendSDFG graspBackend;  // of the hand's shown grasp; NONE when not grasping
+  // Where the session's next build goes: VULKAN once its GPU path is ready (pipelines are made
+  // and warmed up in the session's first frames, off the app's calls), CPU before that (a grab
+  // then is built on the CPU at once; one of a Vulkan-buffer target waits) and after a failure.
+  XrGraspSdfBackendSDFG sessionBackend;
+  uint64_t gpuBuildCount;  // builds of the session done on the GPU so far
+  uint64_t cpuBuildCount;  // and on the CPU
   XrBool32 gpuFailed;  // the GPU path failed (device lost or any Vulkan error): CPU from then on
   uint32_t pendingGpuBuilds;  // GPU builds requested and not yet collected (0..2)
 } XrGraspBuildInfoSDFG;

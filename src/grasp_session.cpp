@@ -205,12 +205,13 @@ Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Targ
       return s;
     hand.prepared = true;
   }
-  if (deferredUsable() && (target.distance == nullptr || deferredForMeshTargets_) &&
-      !deferredReady()) {
-    // Still preparing: a device target waits for it (asked again at the next update); a target
-    // with a CPU mesh is built on the CPU below rather than keep the hand waiting.
+  const bool onDevice = deferredUsable() && (target.distance == nullptr || deferredForMeshTargets_);
+  if (onDevice && !deferredReady()) {
+    // Still preparing (pipelines made at session start): a device target waits for it, asked
+    // again at the next update; a target with a CPU mesh is built on the CPU below rather than
+    // keep the hand waiting. A preparation that failed leaves the CPU only.
     if (target.distance == nullptr && deferredUsable()) return Status::ok;
-  } else if (deferredUsable() && (target.distance == nullptr || deferredForMeshTargets_)) {
+  } else if (onDevice) {
     const TriangleMesh* mesh = target.distance ? &target.distance->mesh() : nullptr;
     const Status s =
         deferred_->request(slot, id, target.version, mesh, objectFromHand, settings_.box);

@@ -72,7 +72,8 @@ bool applyConfigValue(Config& config, const std::string& key, const std::string&
   } else if (key == "extra_queue") {
     ok = parseBool(value, c.extraQueue);
   } else if (key == "test_gpu_fault") {
-    ok = value == "none" || value == "lost_at_submit" || value == "lost_at_poll";
+    ok = value == "none" || value == "lost_at_submit" || value == "lost_at_poll" ||
+         value == "never_ready";
     c.testGpuFault = value;
   } else {
     ok = false;

@@ -1,0 +1,110 @@
+// Internal to VkSdfBuilder (vulkan/vk_sdf_builder*.cpp, vk_sdf_prepare.cpp), not part of the
+// engine's interface: the passes and buffer slots the builder's files share, the Vulkan objects
+// it owns, and the CPU-side preparation of a mesh and a build (pseudo-normals, the winding-number
+// hierarchy's plan, the jump-flooding steps).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+
+#include "vulkan/vk_sdf_builder.h"
+#include "vulkan/vk_sdf_layout.h"
+
+namespace sdfg {
+namespace vk_sdf_detail {
+
+namespace L = vk_layout;
+
+enum Pass : uint32_t {
+  kTransform,
+  kCluster,
+  kSplat,
+  kJfa,
+  kFinalize,
+  kRepair,
+  kSample,
+  kPassCount
+};
+// Timestamps: start, then after transform, hierarchy, splat, flood, finalize (+ repair), sample.
+constexpr uint32_t kTimestampCount = 7;
+
+// Buffers the builder owns, by role.
+enum Slot : uint32_t {
+  kParamsBuf,   // BuildParams, written by the host before each submission
+  kMeshPos,     // uploaded positions (CPU-array meshes)
+  kMeshIdx,     // uploaded 32-bit indices (CPU-array meshes)
+  kStaging,     // host copy of positions, indices, pseudo-normals; copied by the next build
+  kTris,        // triangles in box space
+  kNodes,       // winding-number hierarchy
+  kDistBits,    // splat minimum per node
+  kIdsA,        // closest-triangle ids, ping
+  kIdsB,        // closest-triangle ids, pong
+  kValues,      // the SDF (device side)
+  kPoints,      // points to sample, written by the host
+  kSamples,     // sampled values, read by the host
+  kValuesHost,  // copy of the SDF for the host (readBackGrid)
+  kNormals,     // per-triangle pseudo-normals (closed CPU-array meshes)
+  kSlotCount,
+};
+
+constexpr uint32_t kDevice = 0, kUpload = 1, kReadback = 2;
+
+inline VkMemoryKind memoryKind(uint32_t kind) {
+  return kind == kUpload     ? VkMemoryKind::upload
+         : kind == kReadback ? VkMemoryKind::readback
+                             : VkMemoryKind::device;
+}
+
+inline uint32_t ceilDiv(size_t n, uint32_t d) {
+  return uint32_t((n + d - 1) / d);
+}
+
+// Spreads the low 10 bits of v to every third bit (Morton order of triangle centroids, so that
+// consecutive triangles, the hierarchy's clusters, are close in space).
+uint32_t spreadBits(uint32_t v);
+
+// Pseudo-normals of every triangle's edges and corners when the mesh is closed (every edge has
+// two triangles) and consistently oriented (they traverse it in opposite directions), in the
+// mesh's triangle order; nothing otherwise (those meshes are signed by the winding number).
+std::optional<std::vector<L::TrianglePseudoNormals>> pseudoNormals(const TriangleMesh& mesh);
+
+glm::mat4 poseMatrix(const Pose& pose);
+bool finitePose(const Pose& p);
+
+// Levels of the winding-number hierarchy for `triangles`, each level kFanOut times smaller,
+// up to a top level of at most kFanOut nodes.
+struct Hierarchy {
+  uint32_t levels = 0;
+  uint32_t offset[L::kMaxLevels] = {};
+  uint32_t count[L::kMaxLevels] = {};
+  uint32_t total = 0;
+};
+Hierarchy planHierarchy(uint32_t triangles);
+
+// The jump steps for a grid whose longest axis has `n` nodes: the largest power of two below n,
+// halving to 1, then 2 and 1 again (JFA+2: cleans up most of the flood's misses).
+std::vector<uint32_t> jumpSteps(uint32_t n);
+
+}  // namespace vk_sdf_detail
+
+struct VkSdfBuilder::Objects {
+  // Declaration order is destruction order reversed: buffers go before the pool and layouts.
+  VkOwned<VkDescriptorSetLayout> setLayout;  // the one layout every pass shares
+  VkOwned<VkPipelineLayout> pipelineLayout;  // set 0 + 8 bytes of push constants
+  std::array<VkOwned<VkPipeline>, vk_sdf_detail::kPassCount> pipelines;
+  VkOwned<VkDescriptorPool> descriptorPool;  // owns `set`
+  VkDescriptorSet set = VK_NULL_HANDLE;
+  VkOwned<VkCommandPool> commandPool;    // owns `cmd`; family = the borrowed queue's
+  VkCommandBuffer cmd = VK_NULL_HANDLE;  // re-recorded for every submission
+  VkOwned<VkFence> fence;                // signalled when a submission completes (polled)
+  VkOwned<VkQueryPool> timestamps;       // pass boundaries, only with options.profile
+  std::array<VkBufferAlloc, vk_sdf_detail::kSlotCount> buffers;
+  std::array<uint32_t, vk_sdf_detail::kSlotCount> kinds{};
+  bool descriptorsDirty = true;
+};
+
+}  // namespace sdfg

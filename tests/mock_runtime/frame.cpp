@@ -38,6 +38,10 @@ XrResult verifyLayerSpace(const char* cmd, const Session& session, XrSpace handl
   return XR_SUCCESS;
 }
 
+bool zeroDisplayTime(const Session& session) {
+  return session.instance->options.fault == "zero_display_time";
+}
+
 }  // namespace
 
 XrResult waitFrame(XrSession handle, const XrFrameWaitInfo* info, XrFrameState* state) {
@@ -55,7 +59,9 @@ XrResult waitFrame(XrSession handle, const XrFrameWaitInfo* info, XrFrameState* 
   // Display times strictly increase and never fall behind the clock.
   const XrTime t = std::max(now() + kFramePeriod, session->lastPredicted + kFramePeriod);
   session->lastPredicted = t;
-  state->predictedDisplayTime = t;
+  // Fault "zero_display_time": Monado's headless sessions predict no display time (0), and a
+  // layer must still work there.
+  state->predictedDisplayTime = zeroDisplayTime(*session) ? 0 : t;
   state->predictedDisplayPeriod = kFramePeriod;
   state->shouldRender =
       session->state == XR_SESSION_STATE_VISIBLE || session->state == XR_SESSION_STATE_FOCUSED;
@@ -87,15 +93,12 @@ XrResult endFrame(XrSession handle, const XrFrameEndInfo* info) {
   if (!session->running) return fail(cmd, XR_ERROR_SESSION_NOT_RUNNING, "not running");
   if (!session->frameBegun)
     return fail(cmd, XR_ERROR_CALL_ORDER_INVALID, "no xrBeginFrame before this xrEndFrame");
-  if (info->displayTime <= 0)
+  if (info->displayTime < 0 || (info->displayTime == 0 && !zeroDisplayTime(*session)))
     return fail(cmd, XR_ERROR_TIME_INVALID, "displayTime %lld", (long long)info->displayTime);
-  if (info->environmentBlendMode != XR_ENVIRONMENT_BLEND_MODE_OPAQUE) {
-    const bool known = info->environmentBlendMode == XR_ENVIRONMENT_BLEND_MODE_ADDITIVE ||
-                       info->environmentBlendMode == XR_ENVIRONMENT_BLEND_MODE_ALPHA_BLEND;
-    return fail(cmd,
-                known ? XR_ERROR_ENVIRONMENT_BLEND_MODE_UNSUPPORTED : XR_ERROR_VALIDATION_FAILURE,
-                "environmentBlendMode %d", int(info->environmentBlendMode));
-  }
+  // Every mode but OPAQUE, known or not, is one this system lacks (the CTS passes MAX_ENUM).
+  if (info->environmentBlendMode != XR_ENVIRONMENT_BLEND_MODE_OPAQUE)
+    return fail(cmd, XR_ERROR_ENVIRONMENT_BLEND_MODE_UNSUPPORTED, "environmentBlendMode %d",
+                int(info->environmentBlendMode));
   if (info->layerCount > kMaxLayerCount)
     return fail(cmd, XR_ERROR_LAYER_LIMIT_EXCEEDED, "layerCount %u > %u", info->layerCount,
                 kMaxLayerCount);

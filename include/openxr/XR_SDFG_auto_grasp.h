@@ -62,6 +62,12 @@ typedef struct XrGraspTargetPlacementSDFG {
 // vertexCount: number of vertices (xyz float triples in `vertices`), 3..XR_MAX_..._VERTICES;
 // indexCount: number of uint32 indices, a multiple of 3, 3..XR_MAX_..._INDICES, each below
 // vertexCount. Every coordinate must be finite; no triangle may repeat a vertex.
+// Winding: any. The layer's convention is counter-clockwise (right-handed index order) seen from
+// outside, and at creation it detects each connected part's orientation (signed volume when the
+// part is closed, the generalized winding number when it is open, after making neighbouring
+// triangles consistent) and flips inside-out or mixed parts on its own copy; it logs what it
+// found once per target. A flat open sheet is taken as given. (Vulkan-buffer targets below are
+// not inspected: wind them counter-clockwise.)
 typedef struct XrGraspTargetVerticesSDFG {
   XrStructureType type;  // XR_TYPE_GRASP_TARGET_VERTICES_SDFG
   const void* XR_MAY_ALIAS next;

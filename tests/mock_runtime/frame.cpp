@@ -38,6 +38,19 @@ XrResult verifyLayerSpace(const char* cmd, const Session& session, XrSpace handl
   return XR_SUCCESS;
 }
 
+// Counts a submitted frame and ends the session after the configured number.
+XrResult finishFrame(Session& session, const XrFrameEndInfo& info) {
+  session.frameBegun = false;
+  XrMockRuntimeStatsSDFG& s = session.stats;
+  ++s.framesEnded;
+  s.frameIndex = s.framesEnded;
+  if (info.layerCount > 0) ++s.framesWithLayers;
+  s.lastLayerCount = info.layerCount;
+  const uint64_t n = session.instance->options.endAfterFrames;
+  if (n > 0 && s.framesEnded >= n) beginStopping(session);
+  return XR_SUCCESS;
+}
+
 bool zeroDisplayTime(const Session& session) {
   return session.instance->options.fault == "zero_display_time";
 }
@@ -99,6 +112,9 @@ XrResult endFrame(XrSession handle, const XrFrameEndInfo* info) {
   if (info->environmentBlendMode != XR_ENVIRONMENT_BLEND_MODE_OPAQUE)
     return fail(cmd, XR_ERROR_ENVIRONMENT_BLEND_MODE_UNSUPPORTED, "environmentBlendMode %d",
                 int(info->environmentBlendMode));
+  // A headless session (XR_MND_headless) has no swapchains and composes nothing: its layers are
+  // ignored, as Monado does (the CTS submits a projection of zero views there).
+  if (!session->vulkan) return finishFrame(*session, *info);
   if (info->layerCount > kMaxLayerCount)
     return fail(cmd, XR_ERROR_LAYER_LIMIT_EXCEEDED, "layerCount %u > %u", info->layerCount,
                 kMaxLayerCount);
@@ -147,15 +163,7 @@ XrResult endFrame(XrSession handle, const XrFrameEndInfo* info) {
     if (captured) ++session->stats.framesCaptured;
   }
 
-  session->frameBegun = false;
-  XrMockRuntimeStatsSDFG& s = session->stats;
-  ++s.framesEnded;
-  s.frameIndex = s.framesEnded;
-  if (info->layerCount > 0) ++s.framesWithLayers;
-  s.lastLayerCount = info->layerCount;
-  const uint64_t n = session->instance->options.endAfterFrames;
-  if (n > 0 && s.framesEnded >= n) beginStopping(*session);
-  return XR_SUCCESS;
+  return finishFrame(*session, *info);
 }
 
 }  // namespace sdfg::mock

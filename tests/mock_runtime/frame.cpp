@@ -78,7 +78,7 @@ XrResult waitFrame(XrSession handle, const XrFrameWaitInfo* info, XrFrameState* 
   state->predictedDisplayPeriod = kFramePeriod;
   state->shouldRender =
       session->state == XR_SESSION_STATE_VISIBLE || session->state == XR_SESSION_STATE_FOCUSED;
-  session->frameWaited = true;
+  ++session->framesWaitedPending;
   ++session->stats.framesWaited;
   return XR_SUCCESS;
 }
@@ -89,9 +89,9 @@ XrResult beginFrame(XrSession handle, const XrFrameBeginInfo* info) {
   if (session == nullptr) return fail(cmd, XR_ERROR_HANDLE_INVALID, "session is not valid");
   if (info != nullptr) MOCK_VERIFY_TYPE(cmd, info, XR_TYPE_FRAME_BEGIN_INFO);
   if (!session->running) return fail(cmd, XR_ERROR_SESSION_NOT_RUNNING, "not running");
-  if (!session->frameWaited)
+  if (session->framesWaitedPending == 0)
     return fail(cmd, XR_ERROR_CALL_ORDER_INVALID, "no xrWaitFrame before this xrBeginFrame");
-  session->frameWaited = false;
+  --session->framesWaitedPending;
   ++session->stats.framesBegun;
   if (session->frameBegun) return XR_FRAME_DISCARDED;  // the previous frame is dropped
   session->frameBegun = true;

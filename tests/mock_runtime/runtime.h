@@ -237,6 +237,7 @@ struct Session final : Object {
   // each xrBeginFrame with one of them.
   uint32_t framesWaitedPending = 0;
   bool frameBegun = false;
+  bool profileChangePending = false;  // attached: INTERACTION_PROFILE_CHANGED at the next sync
   XrTime lastPredicted = 0;
   XrMockRuntimeStatsSDFG stats{};
 

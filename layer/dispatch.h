@@ -9,6 +9,7 @@ namespace sdfg::layer {
 
 #define SDFG_NEXT_COMMANDS(X)            \
   X(xrDestroyInstance)                   \
+  X(xrGetSystem)                         \
   X(xrGetSystemProperties)               \
   X(xrCreateSession)                     \
   X(xrDestroySession)                    \
@@ -32,6 +33,7 @@ namespace sdfg::layer {
   X(xrCreateHandTrackerEXT)              \
   X(xrDestroyHandTrackerEXT)             \
   X(xrLocateHandJointsEXT)               \
+  X(xrConvertTimespecTimeToTimeKHR)      \
   X(xrSubmitDebugUtilsMessageEXT)
 
 struct NextDispatch {

@@ -43,13 +43,22 @@ void graspCurls(const HandGrasp& grasp, const FingerCurls& user, FingerJointCurl
 HandFrame trackedFrame(SessionState& s, int h, JointPoses& joints, JointRadii& radii) {
   HandFrame frame;
   InstanceState& inst = *s.instance;
-  if (!inst.downstreamHandTracking || inst.next.xrLocateHandJointsEXT == nullptr) return frame;
+  if (!inst.downstreamHandTracking || inst.next.xrLocateHandJointsEXT == nullptr ||
+      inst.runtimeSystemLacksHands || s.internalTrackerRefused[h])
+    return frame;
   if (s.internalTrackers[h] == XR_NULL_HANDLE) {
     XrHandTrackerCreateInfoEXT info{XR_TYPE_HAND_TRACKER_CREATE_INFO_EXT};
     info.hand = h == 0 ? XR_HAND_LEFT_EXT : XR_HAND_RIGHT_EXT;
     info.handJointSet = XR_HAND_JOINT_SET_DEFAULT_EXT;
-    if (inst.next.xrCreateHandTrackerEXT(s.handle, &info, &s.internalTrackers[h]) != XR_SUCCESS) {
+    const XrResult r = inst.next.xrCreateHandTrackerEXT(s.handle, &info, &s.internalTrackers[h]);
+    if (r != XR_SUCCESS) {
+      // Remembered for the session: a refusal is not retried every frame (each retry is an
+      // error line in the runtime's log).
       s.internalTrackers[h] = XR_NULL_HANDLE;
+      s.internalTrackerRefused[h] = true;
+      SDFG_LOG_INFO("xrSyncActions",
+                    "the runtime refused a %s hand tracker (%d); that hand follows the controller",
+                    h == 0 ? "left" : "right", int(r));
       return frame;
     }
   }
@@ -142,8 +151,18 @@ XrResult XRAPI_CALL SdfgXrCreateHandTrackerEXT(XrSession session,
   InstanceState& inst = *s->instance;
   auto t = std::make_shared<TrackerState>();
   t->session = s;
-  if (!inst.provideHandTracking) {
+  const bool synthesis = inst.config.synthesis;
+  if (!inst.provideHandTracking && !(inst.runtimeSystemLacksHands && synthesis)) {
     const XrResult r = inst.next.xrCreateHandTrackerEXT(session, info, tracker);
+    // A system without hands (the extension listed, controllers only) refuses trackers: the
+    // layer synthesizes the hands instead, and remembers, so later trackers skip the runtime.
+    if (r == XR_ERROR_FEATURE_UNSUPPORTED && synthesis) {
+      if (!inst.runtimeSystemLacksHands.exchange(true))
+        SDFG_LOG_WARN(cmd,
+                      "the runtime's system cannot track hands; the layer synthesizes "
+                      "them from the controllers' grip pose and squeeze");
+      return SdfgXrCreateHandTrackerEXT(session, info, tracker);
+    }
     if (XR_FAILED(r)) return r;
     t->handle = key(*tracker);
     t->runtimeHandle = *tracker;
@@ -170,6 +189,10 @@ XrResult XRAPI_CALL SdfgXrCreateHandTrackerEXT(XrSession session,
   t->hand = handOf(info->hand);
   *tracker = fromKey<XrHandTrackerEXT>(t->handle);
   {
+    std::lock_guard lock(s->mutex);
+    ++s->synthesizedTrackers;
+  }
+  {
     const uint64_t handle = t->handle;
     trackers().insert(handle, std::move(t));
   }
@@ -190,6 +213,10 @@ XrResult XRAPI_CALL SdfgXrDestroyHandTrackerEXT(XrHandTrackerEXT tracker) {
     return r;
   }
   trackers().erase(key(tracker));
+  if (auto s = t->session.lock()) {
+    std::lock_guard lock(s->mutex);
+    --s->synthesizedTrackers;
+  }
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)
 }

@@ -65,7 +65,79 @@ void appendLayerBindings(const InstanceState& instance, const ProfilePaths& path
   }
 }
 
+// An app without suggestions gets the layer's alone, on every profile it knows.
+void suggestOwnBindingsIfAlone(InstanceState& inst) {
+  std::lock_guard lock(inst.inputMutex);
+  if (!inst.appSuggestedProfiles.empty()) return;
+  for (const ProfilePaths& paths : inst.profiles) {
+    if (paths.profile == XR_NULL_PATH) continue;
+    std::vector<XrActionSuggestedBinding> own;
+    appendLayerBindings(inst, paths, own);
+    XrInteractionProfileSuggestedBinding b{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+    b.interactionProfile = paths.profile;
+    b.countSuggestedBindings = uint32_t(own.size());
+    b.suggestedBindings = own.data();
+    (void)inst.next.xrSuggestInteractionProfileBindings(inst.handle, &b);
+  }
+}
+
+// The grip spaces and the LOCAL space the grab update works in. The caller holds s.mutex.
+void createLayerSpaces(SessionState& s) {
+  auto& next = s.instance->next;
+  for (int h = 0; h < 2; ++h) {
+    XrActionSpaceCreateInfo spaceInfo{XR_TYPE_ACTION_SPACE_CREATE_INFO};
+    spaceInfo.action = s.instance->gripAction;
+    spaceInfo.subactionPath = s.instance->handPaths[h];
+    spaceInfo.poseInActionSpace.orientation.w = 1.0f;
+    if (next.xrCreateActionSpace(s.handle, &spaceInfo, &s.gripSpaces[h]) != XR_SUCCESS)
+      s.gripSpaces[h] = XR_NULL_HANDLE;
+  }
+  XrReferenceSpaceCreateInfo local{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};
+  local.referenceSpaceType = XR_REFERENCE_SPACE_TYPE_LOCAL;
+  local.poseInReferenceSpace.orientation.w = 1.0f;
+  if (next.xrCreateReferenceSpace(s.handle, &local, &s.localSpace) != XR_SUCCESS)
+    s.localSpace = XR_NULL_HANDLE;
+}
+
 }  // namespace
+
+void selfAttachIfNeeded(SessionState& s) {
+  constexpr const char* cmd = "xrWaitFrame";
+  InstanceState& inst = *s.instance;
+  if (s.attached || s.appAttached || s.selfAttachFailed || s.synthesizedTrackers == 0 ||
+      inst.actionSet == XR_NULL_HANDLE)
+    return;
+  suggestOwnBindingsIfAlone(inst);
+  XrSessionActionSetsAttachInfo info{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
+  info.countActionSets = 1;
+  info.actionSets = &inst.actionSet;
+  const XrResult r = inst.next.xrAttachSessionActionSets(s.handle, &info);
+  if (XR_FAILED(r)) {
+    // Remembered: never tried again on this session.
+    s.selfAttachFailed = true;
+    SDFG_LOG_WARN(cmd,
+                  "could not attach the layer's action set (%d); synthesized hands stay "
+                  "inactive in this session",
+                  int(r));
+    return;
+  }
+  SDFG_LOG_INFO(cmd,
+                "the app attached no action sets: the layer attached its own so that "
+                "synthesized hands follow the controllers (a later app attach is refused)");
+  s.attached = true;
+  s.selfAttached = true;
+  createLayerSpaces(s);
+}
+
+void syncOwnActions(SessionState& s) {
+  InstanceState& inst = *s.instance;
+  XrActiveActionSet active{inst.actionSet, XR_NULL_PATH};
+  XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
+  sync.countActiveActionSets = 1;
+  sync.activeActionSets = &active;
+  const XrResult r = inst.next.xrSyncActions(s.handle, &sync);
+  if (r == XR_SUCCESS || r == XR_SESSION_NOT_FOCUSED) updateGrasps(s);
+}
 
 void createLayerActions(InstanceState& instance) {
   constexpr const char* cmd = "xrCreateInstance";
@@ -113,9 +185,12 @@ XrResult XRAPI_CALL SdfgXrSuggestInteractionProfileBindings(
   auto state = instances().find(key(instance));
   if (state == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(instance) is not valid");
   auto& next = state->next;
+  // A call the runtime must refuse as the app made it (no bindings at all, VUID
+  // -XrInteractionProfileSuggestedBinding-countSuggestedBindings-arraylength) goes down untouched:
+  // the layer's bindings would make it valid.
   if (state->actionSet == XR_NULL_HANDLE || suggested == nullptr ||
       suggested->type != XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING ||
-      (suggested->countSuggestedBindings > 0 && suggested->suggestedBindings == nullptr))
+      suggested->countSuggestedBindings == 0 || suggested->suggestedBindings == nullptr)
     return next.xrSuggestInteractionProfileBindings(instance, suggested);
   const ProfilePaths* paths = findProfile(*state, suggested->interactionProfile);
   if (paths == nullptr) return next.xrSuggestInteractionProfileBindings(instance, suggested);
@@ -154,26 +229,19 @@ XrResult XRAPI_CALL SdfgXrAttachSessionActionSets(XrSession session,
   if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
   InstanceState& inst = *s->instance;
   auto& next = inst.next;
-  if (inst.actionSet == XR_NULL_HANDLE || info == nullptr ||
-      info->type != XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO ||
-      (info->countActionSets > 0 && info->actionSets == nullptr))
-    return next.xrAttachSessionActionSets(session, info);
+  // As for suggestions: no action set at all (VUID-XrSessionActionSetsAttachInfo
+  // -countActionSets-arraylength) is the runtime's to refuse, and a session the layer already
+  // attached its own set to (selfAttach) can take no more.
+  bool selfAttached;
   {
-    // An app without suggestions gets the layer's alone, on every profile it knows.
-    std::lock_guard lock(inst.inputMutex);
-    if (inst.appSuggestedProfiles.empty()) {
-      for (const ProfilePaths& paths : inst.profiles) {
-        if (paths.profile == XR_NULL_PATH) continue;
-        std::vector<XrActionSuggestedBinding> own;
-        appendLayerBindings(inst, paths, own);
-        XrInteractionProfileSuggestedBinding b{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
-        b.interactionProfile = paths.profile;
-        b.countSuggestedBindings = uint32_t(own.size());
-        b.suggestedBindings = own.data();
-        (void)next.xrSuggestInteractionProfileBindings(inst.handle, &b);
-      }
-    }
+    std::lock_guard lock(s->mutex);
+    selfAttached = s->selfAttached;
   }
+  if (inst.actionSet == XR_NULL_HANDLE || info == nullptr ||
+      info->type != XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO || info->countActionSets == 0 ||
+      info->actionSets == nullptr || selfAttached)
+    return next.xrAttachSessionActionSets(session, info);
+  suggestOwnBindingsIfAlone(inst);
   std::vector<XrActionSet> sets(info->actionSets, info->actionSets + info->countActionSets);
   sets.push_back(inst.actionSet);
   XrSessionActionSetsAttachInfo copy = *info;
@@ -182,25 +250,17 @@ XrResult XRAPI_CALL SdfgXrAttachSessionActionSets(XrSession session,
   XrResult r = next.xrAttachSessionActionSets(session, &copy);
   if (XR_FAILED(r)) {
     const XrResult own = next.xrAttachSessionActionSets(session, info);
-    if (XR_SUCCEEDED(own))
+    if (XR_SUCCEEDED(own)) {
       SDFG_LOG_WARN(cmd, "could not attach the layer's action set (%d)", int(r));
+      std::lock_guard lock(s->mutex);
+      s->appAttached = true;
+    }
     return own;
   }
   std::lock_guard lock(s->mutex);
   s->attached = true;
-  for (int h = 0; h < 2; ++h) {
-    XrActionSpaceCreateInfo spaceInfo{XR_TYPE_ACTION_SPACE_CREATE_INFO};
-    spaceInfo.action = inst.gripAction;
-    spaceInfo.subactionPath = inst.handPaths[h];
-    spaceInfo.poseInActionSpace.orientation.w = 1.0f;
-    if (next.xrCreateActionSpace(session, &spaceInfo, &s->gripSpaces[h]) != XR_SUCCESS)
-      s->gripSpaces[h] = XR_NULL_HANDLE;
-  }
-  XrReferenceSpaceCreateInfo local{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};
-  local.referenceSpaceType = XR_REFERENCE_SPACE_TYPE_LOCAL;
-  local.poseInReferenceSpace.orientation.w = 1.0f;
-  if (next.xrCreateReferenceSpace(session, &local, &s->localSpace) != XR_SUCCESS)
-    s->localSpace = XR_NULL_HANDLE;
+  s->appAttached = true;
+  createLayerSpaces(*s);
   return r;
   SDFG_ENTRY_END(cmd)
 }
@@ -212,11 +272,15 @@ XrResult XRAPI_CALL SdfgXrSyncActions(XrSession session, const XrActionsSyncInfo
   if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
   InstanceState& inst = *s->instance;
   bool attached;
+  bool selfAttached;
   {
     std::lock_guard lock(s->mutex);
     attached = s->attached;
+    selfAttached = s->selfAttached;
   }
-  if (!attached || info == nullptr || info->type != XR_TYPE_ACTIONS_SYNC_INFO ||
+  // A session the layer attached alone: the app has no sets, and its sync is the runtime's to
+  // answer; the layer syncs its own in xrWaitFrame.
+  if (!attached || selfAttached || info == nullptr || info->type != XR_TYPE_ACTIONS_SYNC_INFO ||
       (info->countActiveActionSets > 0 && info->activeActionSets == nullptr))
     return inst.next.xrSyncActions(session, info);
   std::vector<XrActiveActionSet> active(info->activeActionSets,

@@ -81,6 +81,21 @@ std::optional<std::vector<std::string>> chainExtensions(const XrApiLayerNextInfo
   return std::nullopt;
 }
 
+// Whether the head-mounted system below tracks hands (XrSystemHandTrackingPropertiesEXT). False
+// also when it cannot be asked (no such system now): the layer then stays ready to synthesize.
+bool systemHasHands(const InstanceState& state) {
+  if (state.next.xrGetSystem == nullptr || state.next.xrGetSystemProperties == nullptr)
+    return false;
+  XrSystemGetInfo info{XR_TYPE_SYSTEM_GET_INFO};
+  info.formFactor = XR_FORM_FACTOR_HEAD_MOUNTED_DISPLAY;
+  XrSystemId system = XR_NULL_SYSTEM_ID;
+  if (state.next.xrGetSystem(state.handle, &info, &system) != XR_SUCCESS) return false;
+  XrSystemHandTrackingPropertiesEXT hands{XR_TYPE_SYSTEM_HAND_TRACKING_PROPERTIES_EXT};
+  XrSystemProperties props{XR_TYPE_SYSTEM_PROPERTIES, &hands};
+  if (state.next.xrGetSystemProperties(state.handle, system, &props) != XR_SUCCESS) return false;
+  return hands.supportsHandTracking == XR_TRUE;
+}
+
 XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* info,
                                                  const XrApiLayerCreateInfo* layerInfo,
                                                  XrInstance* instance) {
@@ -126,6 +141,7 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
   state->appMotionRange = contains(appExtensions, XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME);
   state->appDebugUtils = contains(appExtensions, XR_EXT_DEBUG_UTILS_EXTENSION_NAME);
   state->appVulkan2 = contains(appExtensions, XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME);
+  const bool appTimespec = contains(appExtensions, XR_KHR_CONVERT_TIMESPEC_TIME_EXTENSION_NAME);
 
   // What the chain offers decides the list sent down. Only when nobody below answers the query
   // does the layer find out by trying, as HTCC does: the full list first, then without motion
@@ -136,6 +152,11 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
       !offered || contains(*offered, XR_EXT_HAND_TRACKING_EXTENSION_NAME);
   const bool offersMotionRange =
       !offered || contains(*offered, XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME);
+  // Grasping needs a time to locate the hands at. A runtime that predicts a display time of 0
+  // (Monado's headless sessions) gives none, so the layer converts the clock itself where the
+  // chain offers the conversion (it is added only when offered: it never costs a retry).
+  state->layerAddedTimespec = wantHandTracking && !appTimespec && offered &&
+                              contains(*offered, XR_KHR_CONVERT_TIMESPEC_TIME_EXTENSION_NAME);
   XrApiLayerCreateInfo downLayerInfo = *layerInfo;
   downLayerInfo.nextInfo = nextInfo->next;
   // Core validation 1.0.20 reports the runtime's refusal as XR_ERROR_INITIALIZATION_FAILED.
@@ -166,6 +187,7 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
       down.push_back(name.c_str());
     }
     if (state->downstreamHandTracking) down.push_back(XR_EXT_HAND_TRACKING_EXTENSION_NAME);
+    if (state->layerAddedTimespec) down.push_back(XR_KHR_CONVERT_TIMESPEC_TIME_EXTENSION_NAME);
     XrInstanceCreateInfo downInfo = *info;
     downInfo.enabledExtensionCount = uint32_t(down.size());
     downInfo.enabledExtensionNames = down.empty() ? nullptr : down.data();
@@ -174,19 +196,29 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
                   withMotionRange, int(r));
   }
   if (XR_FAILED(r)) return r;
-  state->active = state->appAutoGrasp || state->provideHandTracking || state->stripMotionRange;
-
   state->handle = *instance;
   state->next.load(state->nextGipa, *instance);
+  // A runtime may list hand tracking for a system that has no hands (Monado with controllers
+  // only): then the layer synthesizes them. Asked now, because the routing is fixed when the
+  // loader fills its dispatch table right after this call.
+  if (state->appHandTracking && !state->provideHandTracking && state->config.synthesis &&
+      !systemHasHands(*state)) {
+    state->runtimeSystemLacksHands = true;
+    SDFG_LOG_WARN(cmd,
+                  "the runtime's system cannot track hands; the layer synthesizes them from "
+                  "the controllers' grip pose and squeeze");
+  }
+  state->active = state->appAutoGrasp || state->provideHandTracking || state->stripMotionRange ||
+                  state->runtimeSystemLacksHands;
   if (state->appDebugUtils && state->next.xrSubmitDebugUtilsMessageEXT != nullptr)
     setDebugUtilsSink(*instance, state->next.xrSubmitDebugUtilsMessageEXT);
   if (state->active) createLayerActions(*state);
   SDFG_LOG_INFO(cmd,
                 "instance %p: %s (auto_grasp %d, app hand tracking %d, runtime hand tracking %d, "
-                "synthesized %d)",
+                "synthesized %d, system without hands %d)",
                 static_cast<void*>(*instance), state->active ? "active" : "pass-through",
                 state->appAutoGrasp, state->appHandTracking, state->runtimeHandTracking,
-                state->provideHandTracking);
+                state->provideHandTracking, bool(state->runtimeSystemLacksHands));
   instances().insert(key(*instance), std::move(state));
   return r;
   SDFG_ENTRY_END(cmd)
@@ -263,6 +295,7 @@ enum class Gate {
   autoGrasp,     // XR_SDFG_auto_grasp commands: only when the app enabled it
   handTracking,  // XR_EXT_hand_tracking commands: enabled by the app; ours when active
   vulkan2,       // XR_KHR_vulkan_enable2 commands: ours when active and the app enabled it
+  timespec,      // XR_KHR_convert_timespec_time: the next layer's, unless only the layer enabled it
 };
 
 struct Route {
@@ -296,6 +329,8 @@ const Route kRoutes[] = {
     SDFG_ROUTE(XrCreateHandTrackerEXT, Gate::handTracking),
     SDFG_ROUTE(XrDestroyHandTrackerEXT, Gate::handTracking),
     SDFG_ROUTE(XrLocateHandJointsEXT, Gate::handTracking),
+    Route{"xrConvertTimespecTimeToTimeKHR", nullptr, Gate::timespec},
+    Route{"xrConvertTimeToTimespecTimeKHR", nullptr, Gate::timespec},
     SDFG_ROUTE(XrCreateGraspTargetSDFG, Gate::autoGrasp),
     SDFG_ROUTE(XrDestroyGraspTargetSDFG, Gate::autoGrasp),
     SDFG_ROUTE(XrUpdateGraspTargetVerticesSDFG, Gate::autoGrasp),
@@ -347,6 +382,10 @@ XrResult XRAPI_CALL SdfgXrGetInstanceProcAddr(XrInstance instance, const char* n
           *function = route.function;
           return XR_SUCCESS;
         }
+        break;
+      case Gate::timespec:
+        // Enabled below only for the layer's own clock: not the app's to call (spec 3.2).
+        if (state->layerAddedTimespec) return XR_ERROR_FUNCTION_UNSUPPORTED;
         break;
       case Gate::handTracking:
         if (!state->appHandTracking) return XR_ERROR_FUNCTION_UNSUPPORTED;

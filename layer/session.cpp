@@ -21,6 +21,26 @@ void rememberSpace(const std::shared_ptr<SessionState>& s, XrSpace space) {
   spaceOwners().insert(key(space), s);
 }
 
+// The current time in the runtime's XrTime, for a frame whose predicted display time is 0 (or
+// negative): every grasp needs a time to locate hands and targets at. 0 when the chain offers
+// no conversion; then the layer says once that this session cannot grasp.
+XrTime layerClockTime(SessionState& s, const char* cmd) {
+  InstanceState& inst = *s.instance;
+  XrTime t = 0;
+  timespec now{};
+  if (inst.next.xrConvertTimespecTimeToTimeKHR != nullptr &&
+      clock_gettime(CLOCK_MONOTONIC, &now) == 0 &&
+      inst.next.xrConvertTimespecTimeToTimeKHR(inst.handle, &now, &t) == XR_SUCCESS && t > 0)
+    return t;
+  if (!s.noTimeLogged) {
+    s.noTimeLogged = true;
+    SDFG_LOG_WARN(cmd,
+                  "the runtime predicts no display time and offers no "
+                  "XR_KHR_convert_timespec_time: no grasps in this session");
+  }
+  return 0;
+}
+
 }  // namespace
 
 XrResult XRAPI_CALL SdfgXrGetSystemProperties(XrInstance instance, XrSystemId systemId,
@@ -29,8 +49,22 @@ XrResult XRAPI_CALL SdfgXrGetSystemProperties(XrInstance instance, XrSystemId sy
   SDFG_ENTRY_BEGIN
   auto state = instanceOf(instance);
   if (state == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(instance) is not valid");
-  if (!state->provideHandTracking || properties == nullptr)
-    return state->next.xrGetSystemProperties(instance, systemId, properties);
+  if (!state->provideHandTracking || properties == nullptr) {
+    const XrResult r = state->next.xrGetSystemProperties(instance, systemId, properties);
+    if (XR_FAILED(r) || properties == nullptr || !state->appHandTracking) return r;
+    // The runtime lists the extension, but its system may have no hands (controllers only): the
+    // layer synthesizes them and says so, once per instance.
+    auto* hand = findInChain<XrSystemHandTrackingPropertiesEXT>(
+        properties->next, XR_TYPE_SYSTEM_HAND_TRACKING_PROPERTIES_EXT);
+    if (hand != nullptr && !hand->supportsHandTracking && state->config.synthesis) {
+      hand->supportsHandTracking = XR_TRUE;
+      if (!state->runtimeSystemLacksHands.exchange(true))
+        SDFG_LOG_WARN(cmd,
+                      "the runtime's system cannot track hands; the layer synthesizes "
+                      "them from the controllers' grip pose and squeeze");
+    }
+    return r;
+  }
   // The runtime does not know XR_EXT_hand_tracking: unlink its struct for the call down (core
   // validation below would report it), then link it back and answer it.
   auto* chain = reinterpret_cast<XrBaseOutStructure*>(properties);
@@ -131,8 +165,16 @@ XrResult XRAPI_CALL SdfgXrWaitFrame(XrSession session, const XrFrameWaitInfo* in
   if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
   const XrResult r = s->instance->next.xrWaitFrame(session, info, frameState);
   if (XR_SUCCEEDED(r) && frameState != nullptr) {
-    std::lock_guard lock(s->mutex);
-    s->predictedTime = frameState->predictedDisplayTime;
+    // The layer's own work never changes the app's result.
+    try {
+      std::lock_guard lock(s->mutex);
+      s->predictedTime = frameState->predictedDisplayTime;
+      if (s->predictedTime <= 0) s->predictedTime = layerClockTime(*s, cmd);
+      selfAttachIfNeeded(*s);
+      if (s->selfAttached) syncOwnActions(*s);
+    } catch (...) {
+      SDFG_LOG_WARN(cmd, "frame update failed; hands pass through this frame");
+    }
   }
   return r;
   SDFG_ENTRY_END(cmd)

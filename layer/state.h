@@ -66,7 +66,12 @@ struct InstanceState {
   bool appMotionRange = false;
   bool appDebugUtils = false;
   bool runtimeHandTracking = false;
+  // The runtime lists XR_EXT_hand_tracking but its system cannot track hands
+  // (supportsHandTracking false, or it refused a tracker): the layer synthesizes the app's hands.
+  std::atomic<bool> runtimeSystemLacksHands{false};
   bool runtimeMotionRange = false;
+  // XR_KHR_convert_timespec_time was added below by the layer (the app did not enable it).
+  bool layerAddedTimespec = false;
   // The layer answers XR_EXT_hand_tracking itself (app enabled it, the runtime lacks it).
   bool provideHandTracking = false;
   // XR_EXT_hand_tracking is enabled on the runtime (the app's, or added for grasping).
@@ -111,9 +116,21 @@ struct SessionState {
   std::mutex mutex;           // guards everything below
   std::set<uint64_t> spaces;  // reference and action spaces the app created on this session
   bool attached = false;      // the layer's action set is attached with the app's
+  // The app attached no action sets but located synthesized hands: the layer attached its set
+  // alone (input.cpp selfAttachIfNeeded) and syncs it in xrWaitFrame; tried once.
+  bool selfAttached = false;
+  bool selfAttachFailed = false;
+  bool appAttached = false;     // the app's own sets are attached (with or without the layer's)
+  int synthesizedTrackers = 0;  // live synthesized trackers the app made on this session
+  // The runtime refused the layer's own hand tracker for a hand: remembered, never retried.
+  std::array<bool, 2> internalTrackerRefused{};
+  // Said once: the runtime's display time is unusable and the layer cannot convert one.
+  bool noTimeLogged = false;
   std::array<XrSpace, 2> gripSpaces{};
   XrSpace localSpace = XR_NULL_HANDLE;
-  XrTime predictedTime = 0;  // from the last xrWaitFrame
+  // From the last xrWaitFrame; where the runtime predicts no time (0, as Monado's headless
+  // sessions), the current time through XR_KHR_convert_timespec_time.
+  XrTime predictedTime = 0;
   std::array<float, 2> squeeze{};
   std::array<XrHandTrackerEXT, 2> internalTrackers{};  // the layer's own, on the runtime
   std::unique_ptr<GraspSession> grasp;
@@ -257,6 +274,11 @@ std::string resolveSolverName(const std::string& name);
 
 // Runs the layer's grab update for both hands after the app's xrSyncActions.
 void updateGrasps(SessionState& session);
+// input.cpp, for a session whose app attached no action sets but made synthesized trackers:
+// attaches the layer's set alone (once), and syncs it plus the grab update each frame. The
+// caller holds session.mutex.
+void selfAttachIfNeeded(SessionState& session);
+void syncOwnActions(SessionState& session);
 
 // vulkan.cpp: the Vulkan SDF backend for a session created with a Vulkan binding (null when the
 // layer is built without it, the config says gpu = false, or the device cannot be used; the

@@ -16,6 +16,11 @@ packages=(
   libassimp-dev libcgal-dev libgmp-dev libmpfr-dev
   # images and plots for the demo and the benchmark report
   libpng-dev gnuplot-nox
+  # the OpenXR CTS, built from ../shared/cts by `ctest -L cts` (tests/cts/build_cts.sh)
+  python3 python3-jinja2 libx11-xcb-dev libxrandr-dev libxxf86vm-dev mesa-common-dev
+  libxcb-glx0-dev
+  # Monado, built from ../shared/monado by `ctest -L monado` (tests/monado/build_monado.sh)
+  libeigen3-dev libudev-dev
 )
 
 missing=()

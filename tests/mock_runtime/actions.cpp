@@ -295,14 +295,9 @@ XrResult attachSessionActionSets(XrSession handle, const XrSessionActionSetsAtta
   else if (instance.suggested.count(simple) != 0)
     session->profile = simple;
   session->stats.currentProfile = session->profile;
-  if (session->profile != XR_NULL_PATH) {
-    XrEventDataBuffer buffer{XR_TYPE_EVENT_DATA_BUFFER};
-    auto* e = reinterpret_cast<XrEventDataInteractionProfileChanged*>(&buffer);
-    e->type = XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED;
-    e->next = nullptr;
-    e->session = handle;
-    queueEvent(instance, buffer);
-  }
+  // The change is announced by the next xrSyncActions: the spec queues the event only there
+  // (the CTS's conformance layer checks it).
+  session->profileChangePending = session->profile != XR_NULL_PATH;
   return XR_SUCCESS;
 }
 
@@ -406,6 +401,15 @@ XrResult syncActions(XrSession handle, const XrActionsSyncInfo* info) {
     }
   }
   ++session->stats.syncCount;
+  if (session->profileChangePending) {
+    session->profileChangePending = false;
+    XrEventDataBuffer buffer{XR_TYPE_EVENT_DATA_BUFFER};
+    auto* e = reinterpret_cast<XrEventDataInteractionProfileChanged*>(&buffer);
+    e->type = XR_TYPE_EVENT_DATA_INTERACTION_PROFILE_CHANGED;
+    e->next = nullptr;
+    e->session = handle;
+    queueEvent(instance, buffer);
+  }
   return focused ? XR_SUCCESS : XR_SESSION_NOT_FOCUSED;
 }
 

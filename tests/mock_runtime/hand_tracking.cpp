@@ -74,8 +74,10 @@ XrResult createHandTracker(XrSession handle, const XrHandTrackerCreateInfoEXT* i
     return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "hand %d", int(info->hand));
   if (info->handJointSet != XR_HAND_JOINT_SET_DEFAULT_EXT)
     return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "handJointSet %d", int(info->handJointSet));
-  if (session->instance->handTracking != HandTrackingMode::supported)
+  if (session->instance->handTracking != HandTrackingMode::supported) {
+    ++session->stats.handTrackersRefused;
     return fail(cmd, XR_ERROR_FEATURE_UNSUPPORTED, "the system has no hand tracking");
+  }
   auto tracker = std::make_unique<HandTracker>();
   tracker->session = session;
   tracker->hand = info->hand;

@@ -199,8 +199,8 @@ XrResult createInstance(const XrInstanceCreateInfo* info, XrInstance* out) {
     return fail(cmd, XR_ERROR_API_VERSION_UNSUPPORTED, "apiVersion %llu.%llu",
                 (unsigned long long)XR_VERSION_MAJOR(app.apiVersion),
                 (unsigned long long)XR_VERSION_MINOR(app.apiVersion));
-  if (info->enabledApiLayerCount != 0)
-    return fail(cmd, XR_ERROR_API_LAYER_NOT_PRESENT, "the runtime has no API layers");
+  // enabledApiLayerNames are the loader's business: it has loaded them (or refused the app)
+  // before the runtime sees the list, so a runtime ignores it.
   if (theInstance()) return fail(cmd, XR_ERROR_LIMIT_REACHED, "one instance at a time");
 
   auto instance = std::make_unique<Instance>();

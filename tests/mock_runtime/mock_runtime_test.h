@@ -34,7 +34,9 @@ extern "C" {
 #define SDFG_MOCK_ENV_PROFILE "SDFG_MOCK_PROFILE"
 // One deliberate misbehaviour, so tests can prove their checks catch it:
 // "skip_layout_transition": swapchain images stay in VK_IMAGE_LAYOUT_UNDEFINED (the Vulkan
-// validation layer then reports the app's render pass).
+// validation layer then reports the app's render pass);
+// "zero_display_time": xrWaitFrame predicts a display time of 0 and xrEndFrame accepts 0, as
+// Monado does in headless sessions.
 #define SDFG_MOCK_ENV_FAULT "SDFG_MOCK_FAULT"
 // "1": log every error the runtime returns, and why, on stderr.
 #define SDFG_MOCK_ENV_LOG "SDFG_MOCK_LOG"
@@ -54,6 +56,7 @@ typedef struct XrMockRuntimeStatsSDFG {
   float lastHapticAmplitude[2];
   uint64_t syncCount;                             // xrSyncActions calls that succeeded
   XrHandJointsMotionRangeEXT lastMotionRange[2];  // last requested per hand, 0 if none
+  uint64_t handTrackersRefused;  // xrCreateHandTrackerEXT calls refused: no hand tracking
 } XrMockRuntimeStatsSDFG;
 
 // Replaces the instance's timeline (and its directives) with `scriptText`, a NUL-terminated

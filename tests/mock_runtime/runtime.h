@@ -235,8 +235,13 @@ struct Session final : Object {
   bool stopping = false;  // STOPPING queued, waiting for xrEndSession
   XrViewConfigurationType viewConfiguration = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
 
-  bool frameWaited = false;  // xrWaitFrame done, xrBeginFrame not yet
+  // xrWaitFrame calls not yet followed by their xrBeginFrame. More than one when the app
+  // pipelines frames on two threads (the CTS's Timed_Pipelined_Frame_Submission): a real runtime
+  // would block the later xrWaitFrame, this one (all calls serialized) lets it through and pairs
+  // each xrBeginFrame with one of them.
+  uint32_t framesWaitedPending = 0;
   bool frameBegun = false;
+  bool profileChangePending = false;  // attached: INTERACTION_PROFILE_CHANGED at the next sync
   XrTime lastPredicted = 0;
   XrMockRuntimeStatsSDFG stats{};
 

@@ -35,6 +35,9 @@ void beginStopping(Session& session) {
   session.stopping = true;
   if (session.state == XR_SESSION_STATE_FOCUSED) queueState(session, XR_SESSION_STATE_VISIBLE);
   if (session.state == XR_SESSION_STATE_VISIBLE) queueState(session, XR_SESSION_STATE_SYNCHRONIZED);
+  // STOPPING is only entered from SYNCHRONIZED (spec 9.3): a session asked to stop before its
+  // first frame passes through it (the CTS's conformance layer checks every transition).
+  if (session.state == XR_SESSION_STATE_READY) queueState(session, XR_SESSION_STATE_SYNCHRONIZED);
   queueState(session, XR_SESSION_STATE_STOPPING);
 }
 
@@ -174,7 +177,8 @@ XrResult endSession(XrSession handle) {
     return fail(cmd, XR_ERROR_SESSION_NOT_STOPPING, "state is %d, not STOPPING",
                 int(session->state));
   session->running = false;
-  session->frameWaited = session->frameBegun = false;
+  session->framesWaitedPending = 0;
+  session->frameBegun = false;
   queueState(*session, XR_SESSION_STATE_IDLE);
   queueState(*session, XR_SESSION_STATE_EXITING);
   return XR_SUCCESS;

@@ -185,6 +185,7 @@ Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Targ
       hand.pending = true;
       hand.pendingPose = objectFromHand;
       hand.pendingVersion = target.version;
+      hand.pendingTime = hand.frameTime;
       return Status::ok;
     }
     // Busy with a cancelled build still on the device: ask again at the next update.
@@ -197,11 +198,12 @@ Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Targ
       s != Status::ok)
     return s;
   ++stats_.cpuBuilds;
-  return solveWithGrid(hand, objectFromHand, target.version, false, target.distance.get());
+  return solveWithGrid(hand, objectFromHand, target.version, false, target.distance.get(),
+                       hand.frameTime);
 }
 
 Status GraspSession::solveWithGrid(HandState& hand, const Pose& objectFromHand, uint64_t version,
-                                   bool gpu, const MeshDistance* exactMesh) {
+                                   bool gpu, const MeshDistance* exactMesh, int64_t time) {
   GraspScene scene;
   scene.field = &hand.grid;
   scene.objectFromHand = objectFromHand;
@@ -213,6 +215,8 @@ Status GraspSession::solveWithGrid(HandState& hand, const Pose& objectFromHand, 
   GraspResult result;
   if (Status s = hand.solver->solve(scene, result); s != Status::ok) return s;
   hand.grasp.result = result;
+  hand.grasp.contacts = computeContacts(hand.model, result, objectFromHand, exactMesh, &hand.grid);
+  hand.grasp.time = time;
   hand.grasp.objectFromHand = objectFromHand;
   hand.grasp.builtOnGpu = gpu;
   hand.solvedVersion = version;
@@ -235,7 +239,7 @@ Status GraspSession::collect(HandState& hand, size_t slot) {
     ++stats_.gpuBuilds;
     // A result for older vertices is still shown; the next update asks again.
     return solveWithGrid(hand, hand.pendingPose, hand.pendingVersion, true,
-                         it->second.distance.get());
+                         it->second.distance.get(), hand.pendingTime);
   }
   // The device failed (or lost the request): redo the build on the CPU now.
   if (p == BuildPoll::failed) stats_.gpuFailed = true;
@@ -250,7 +254,7 @@ Status GraspSession::collect(HandState& hand, size_t slot) {
   }
   ++stats_.cpuBuilds;
   return solveWithGrid(hand, hand.pendingPose, hand.pendingVersion, false,
-                       it->second.distance.get());
+                       it->second.distance.get(), hand.pendingTime);
 }
 
 Status GraspSession::update(Hand side, const HandFrame& frame,
@@ -258,6 +262,7 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   const size_t slot = size_t(side);
   HandState& hand = hands_[slot];
   hand.squeeze = std::isfinite(frame.squeeze) ? frame.squeeze : 0.0f;
+  hand.frameTime = frame.time;
   const Status collected = collect(hand, slot);
   if (hand.grasp.holding) {
     auto it = targets_.find(hand.grasp.target);

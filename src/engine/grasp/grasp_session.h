@@ -25,6 +25,7 @@
 #include <string>
 
 #include "base/status.h"
+#include "grasp/contact.h"
 #include "grasp/solver.h"
 #include "hand/hand_model.h"
 #include "mesh/mesh.h"
@@ -59,6 +60,9 @@ struct HandFrame {
   // them when a grab starts. Null for controller-driven hands (the default adult model).
   const JointPoses* trackedJoints = nullptr;
   const std::array<float, kJointCount>* trackedRadii = nullptr;
+  // The caller's time stamp of this frame (the layer: the predicted display time the poses were
+  // located at), handed back as HandGrasp::time of the solves made from it.
+  int64_t time = 0;
 };
 
 struct TargetFrame {
@@ -74,6 +78,10 @@ struct HandGrasp {
   Pose objectFromHand;      // at the last solve
   uint64_t solves = 0;      // how many times this grab was solved
   bool builtOnGpu = false;  // the SDF of the last solve came from the deferred (GPU) backend
+  // Per finger, where it touches the target (target frame), computed at each solve: exact on
+  // targets with a CPU mesh, from the field on device targets (contact.h).
+  FingerContacts contacts{};
+  int64_t time = 0;  // HandFrame::time of the frame whose poses the last solve used
 };
 
 // Where the session's grab-box SDFs were built so far.
@@ -160,13 +168,16 @@ class GraspSession {
     bool pending = false;
     Pose pendingPose;
     uint64_t pendingVersion = 0;
+    int64_t pendingTime = 0;
+    int64_t frameTime = 0;  // HandFrame::time of the update in progress
   };
 
   Status solve(HandState& hand, size_t slot, uint64_t id, const Target& target,
                const Pose& objectFromHand);
-  // `exactMesh`: the target's mesh for the exact check (null: none).
+  // `exactMesh`: the target's mesh for the exact check and the contacts (null: none); `time`:
+  // the HandFrame::time the pose came from.
   Status solveWithGrid(HandState& hand, const Pose& objectFromHand, uint64_t version, bool gpu,
-                       const MeshDistance* exactMesh);
+                       const MeshDistance* exactMesh, int64_t time);
   // Collects the hand's deferred build, if any; on a device failure redoes it on the CPU.
   Status collect(HandState& hand, size_t slot);
   void cancelPending(HandState& hand, size_t slot);

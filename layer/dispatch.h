@@ -9,6 +9,7 @@ namespace sdfg::layer {
 
 #define SDFG_NEXT_COMMANDS(X)            \
   X(xrDestroyInstance)                   \
+  X(xrPollEvent)                         \
   X(xrGetSystemProperties)               \
   X(xrCreateSession)                     \
   X(xrDestroySession)                    \

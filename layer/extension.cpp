@@ -243,7 +243,14 @@ XrResult XRAPI_CALL SdfgXrDestroyGraspTargetSDFG(XrGraspTargetSDFG target) {
   SDFG_VERIFY(cmd, t != nullptr, XR_ERROR_HANDLE_INVALID, "(target) is not valid");
   std::lock_guard lock(s->mutex);
   // A hand holding it lets go; its fingers return to the user's pose at the next locate.
-  if (s->grasp != nullptr) s->grasp->removeTarget(t->handle);
+  if (s->grasp != nullptr) {
+    for (Hand hand : {Hand::left, Hand::right}) {
+      const HandGrasp& g = s->grasp->grasp(hand);
+      if (g.holding && g.solves > 0 && g.target == t->handle)
+        noteGraspChange(*s, hand, true, t->handle, /*destroyed=*/true);
+    }
+    s->grasp->removeTarget(t->handle);
+  }
 #if SDFG_LAYER_VULKAN
   // Waits for the layer's reads of the app's buffers in flight: the app may free them next.
   if (t->deviceBuffers && s->vulkanBackend != nullptr)
@@ -337,10 +344,16 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
     const FingerState& fs = g.result.fingers[f];
     out.curl = held ? fs.curl : 0.0f;
     out.inContact = held && fs.contact ? XR_TRUE : XR_FALSE;
-    const glm::vec3 p = held ? g.objectFromHand.transformPoint(fs.contactPoint) : glm::vec3(0.0f);
+    // Version 2: the touching sphere's centre and the signed distance there (contact.h).
+    const FingerContact& c = g.contacts[f];
+    const bool honest = held && fs.contact && c.valid;
+    const glm::vec3 p = honest ? c.center
+                        : held ? g.objectFromHand.transformPoint(fs.contactPoint)
+                               : glm::vec3(0.0f);
     out.contactPoint = {p.x, p.y, p.z};
-    out.distance = held ? fs.distance : 0.0f;
+    out.distance = honest ? c.distance : held ? fs.distance : 0.0f;
   }
+  writeGraspStateV2(*s, hand, held, state);
   if (auto* info = findInChain<XrGraspBuildInfoSDFG>(state->next, XR_TYPE_GRASP_BUILD_INFO_SDFG)) {
     const SdfBuildStats& st = s->grasp->buildStats();
     info->graspBackend = !held          ? XR_GRASP_SDF_BACKEND_NONE_SDFG

@@ -113,6 +113,7 @@ void updateGrasps(SessionState& s) {
     JointRadii radii;
     HandFrame frame = trackedFrame(s, h, joints, radii);
     frame.squeeze = s.squeeze[h];
+    frame.time = s.predictedTime;
     if (frame.valid && !squeezeActive) {
       // A tracked hand without a controller grabs by closing: its mean finger curl.
       JointPoses local;
@@ -127,8 +128,12 @@ void updateGrasps(SessionState& s) {
         frame.worldFromWrist = *grip * wristFromGrip(s.grasp->model(hand)).inverse();
       }
     }
+    const HandGrasp& before = s.grasp->grasp(hand);
+    const bool wasGrasping = before.holding && before.solves > 0;
+    const uint64_t wasTarget = before.target;
     if (Status st = s.grasp->update(hand, frame, frames); st != Status::ok)
       SDFG_LOG_WARN(cmd, "grasp solve failed (%s); the hand stays open", toString(st));
+    noteGraspChange(s, hand, wasGrasping, wasTarget);
   }
 }
 

@@ -49,6 +49,17 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession, const XrGraspStateGetInfo
                                             XrGraspStateSDFG*);
 XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession, const XrGraspOptionsSDFG*);
 
+// grasp_output.cpp: fills the version 2 structs chained on an XrGraspStateSDFG (contacts, held
+// pose) for a hand; `held` as isGrasping. The caller holds session.mutex.
+void writeGraspStateV2(const SessionState& session, Hand hand, bool held, XrGraspStateSDFG* state);
+
+// events.cpp: xrPollEvent with the layer's grasp events, and the event of a hand whose grasp
+// changed since it was `wasGrasping` `wasTarget` (`destroyed`: its target is being destroyed).
+// The caller holds session.mutex.
+XrResult XRAPI_CALL SdfgXrPollEvent(XrInstance, XrEventDataBuffer*);
+void noteGraspChange(SessionState& session, Hand hand, bool wasGrasping, uint64_t wasTarget,
+                     bool destroyed = false);
+
 // input.cpp: creates the layer's action set and actions on a new instance.
 void createLayerActions(InstanceState& instance);
 // hands.cpp: destroys the layer's internal trackers of a session (before it goes away).

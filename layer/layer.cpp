@@ -263,6 +263,7 @@ enum class Gate {
   autoGrasp,     // XR_SDFG_auto_grasp commands: only when the app enabled it
   handTracking,  // XR_EXT_hand_tracking commands: enabled by the app; ours when active
   vulkan2,       // XR_KHR_vulkan_enable2 commands: ours when active and the app enabled it
+  events,        // xrPollEvent: ours when the app enabled XR_SDFG_auto_grasp (its events)
 };
 
 struct Route {
@@ -279,6 +280,7 @@ struct Route {
 const Route kRoutes[] = {
     SDFG_ROUTE(XrGetInstanceProcAddr, Gate::always),
     SDFG_ROUTE(XrDestroyInstance, Gate::always),
+    SDFG_ROUTE(XrPollEvent, Gate::events),
     SDFG_ROUTE(XrGetSystemProperties, Gate::active),
     SDFG_ROUTE(XrCreateSession, Gate::active),
     SDFG_ROUTE(XrDestroySession, Gate::active),
@@ -344,6 +346,12 @@ XrResult XRAPI_CALL SdfgXrGetInstanceProcAddr(XrInstance instance, const char* n
         return XR_SUCCESS;
       case Gate::vulkan2:
         if (state->active && state->appVulkan2 && state->appAutoGrasp) {
+          *function = route.function;
+          return XR_SUCCESS;
+        }
+        break;
+      case Gate::events:
+        if (state->active && state->appAutoGrasp) {
           *function = route.function;
           return XR_SUCCESS;
         }

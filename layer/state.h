@@ -14,6 +14,7 @@
 
 #include "config.h"
 #include "dispatch.h"
+#include "events.h"
 #include "grasp/grasp_session.h"
 #include "hand/hand_synthesis.h"
 #include "xr_includes.h"
@@ -97,6 +98,9 @@ struct InstanceState {
   std::unordered_map<uint64_t, PFN_vkGetInstanceProcAddr> vulkanGipa;  // by VkInstance
   VkInstance lastVulkanInstance = VK_NULL_HANDLE;
   std::unordered_map<uint64_t, ExtraQueue> extraQueues;  // by VkDevice
+
+  // XR_SDFG_auto_grasp version 2: the layer's events waiting for xrPollEvent (events.cpp).
+  EventQueue events;
 };
 
 struct TargetState;

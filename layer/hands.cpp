@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "data_source.h"
 #include "intercepts.h"
 #include "log.h"
 #include "state.h"
@@ -148,6 +149,10 @@ XrResult XRAPI_CALL SdfgXrCreateHandTrackerEXT(XrSession session,
   auto t = std::make_shared<TrackerState>();
   t->session = s;
   if (!inst.provideHandTracking) {
+    if (XrResult v = readDataSourceInfo(cmd, inst, info, *t); v != XR_SUCCESS) return v;
+    const ChainUnlink unlink(
+        layerAnswersDataSource(inst) && info != nullptr ? &info->next : nullptr,
+        XR_TYPE_HAND_TRACKING_DATA_SOURCE_INFO_EXT);
     const XrResult r = inst.next.xrCreateHandTrackerEXT(session, info, tracker);
     if (XR_FAILED(r)) return r;
     t->handle = key(*tracker);
@@ -171,6 +176,7 @@ XrResult XRAPI_CALL SdfgXrCreateHandTrackerEXT(XrSession session,
                     int(info->handJointSet));
   if (!inst.config.synthesis)
     return logError(XR_ERROR_FEATURE_UNSUPPORTED, cmd, "hand synthesis is switched off");
+  if (XrResult v = readDataSourceInfo(cmd, inst, info, *t); v != XR_SUCCESS) return v;
   t->handle = newLayerHandle();
   t->hand = handOf(info->hand);
   *tracker = fromKey<XrHandTrackerEXT>(t->handle);
@@ -211,6 +217,9 @@ XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT tracker,
 
   if (t->runtimeHandle != XR_NULL_HANDLE) {
     XrResult r;
+    ChainUnlink unlink(
+        layerAnswersDataSource(inst) && locations != nullptr ? &locations->next : nullptr,
+        XR_TYPE_HAND_TRACKING_DATA_SOURCE_STATE_EXT);
     if (inst.stripMotionRange && info != nullptr &&
         findInChain<const XrBaseInStructure>(info->next,
                                              XR_TYPE_HAND_JOINTS_MOTION_RANGE_INFO_EXT)) {
@@ -221,6 +230,9 @@ XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT tracker,
     } else {
       r = inst.next.xrLocateHandJointsEXT(t->runtimeHandle, info, locations);
     }
+    unlink.restore();
+    if (r == XR_SUCCESS)
+      writeDataSourceState(inst, *t, locations, XR_HAND_TRACKING_DATA_SOURCE_UNOBSTRUCTED_EXT);
     if (r != XR_SUCCESS || !locations->isActive) return r;
     try {
       std::lock_guard lock(s->mutex);
@@ -298,7 +310,10 @@ XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT tracker,
       v.angularVelocity = {0, 0, 0};
     }
   }
-  if (!active) {
+  if (!active || (layerAnswersDataSource(inst) && !t->allowController)) {
+    // No grip, or the app does not accept joints synthesized from a controller.
+    locations->isActive = XR_FALSE;
+    writeDataSourceState(inst, *t, locations, XR_HAND_TRACKING_DATA_SOURCE_CONTROLLER_EXT);
     for (auto& l : std::span(locations->jointLocations, XR_HAND_JOINT_COUNT_EXT)) {
       l.locationFlags = 0;
       l.pose = XrPosef{{0, 0, 0, 1}, {0, 0, 0}};
@@ -326,6 +341,7 @@ XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT tracker,
     l.radius = radii[j];
     l.locationFlags = kAllBits;
   }
+  writeDataSourceState(inst, *t, locations, XR_HAND_TRACKING_DATA_SOURCE_CONTROLLER_EXT);
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)
 }

@@ -22,6 +22,8 @@ constexpr OwnExtension kOwnExtensions[] = {
     {XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_SDFG_auto_grasp_SPEC_VERSION},
     {XR_EXT_HAND_TRACKING_EXTENSION_NAME, XR_EXT_hand_tracking_SPEC_VERSION},
     {XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME, XR_EXT_hand_joints_motion_range_SPEC_VERSION},
+    {XR_EXT_HAND_TRACKING_DATA_SOURCE_EXTENSION_NAME,
+     XR_EXT_hand_tracking_data_source_SPEC_VERSION},
 };
 
 XrResult XRAPI_CALL SdfgXrGetInstanceProcAddr(XrInstance, const char*, PFN_xrVoidFunction*);
@@ -124,6 +126,7 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
   state->appAutoGrasp = contains(appExtensions, XR_SDFG_AUTO_GRASP_EXTENSION_NAME);
   state->appHandTracking = contains(appExtensions, XR_EXT_HAND_TRACKING_EXTENSION_NAME);
   state->appMotionRange = contains(appExtensions, XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME);
+  state->appDataSource = contains(appExtensions, XR_EXT_HAND_TRACKING_DATA_SOURCE_EXTENSION_NAME);
   state->appDebugUtils = contains(appExtensions, XR_EXT_DEBUG_UTILS_EXTENSION_NAME);
   state->appVulkan2 = contains(appExtensions, XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME);
 
@@ -134,6 +137,9 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
   const std::optional<std::vector<std::string>> offered = chainExtensions(nextInfo);
   const bool offersHandTracking =
       !offered || contains(*offered, XR_EXT_HAND_TRACKING_EXTENSION_NAME);
+  // Only a runtime that says it has the data source (and hand tracking) is sent it.
+  const bool offersDataSource =
+      offered && contains(*offered, XR_EXT_HAND_TRACKING_DATA_SOURCE_EXTENSION_NAME);
   const bool offersMotionRange =
       !offered || contains(*offered, XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME);
   XrApiLayerCreateInfo downLayerInfo = *layerInfo;
@@ -156,6 +162,7 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
     state->provideHandTracking = state->appHandTracking && !withHandTracking;
     state->stripMotionRange = state->appMotionRange && !withMotionRange;
     state->downstreamHandTracking = withHandTracking && wantHandTracking;
+    state->runtimeDataSource = state->appDataSource && withHandTracking && offersDataSource;
     // What goes down: the app's list without the layer's own extensions (the runtime would
     // answer XR_ERROR_EXTENSION_NOT_PRESENT), plus hand tracking when grasping wants it.
     std::vector<const char*> down;
@@ -163,6 +170,8 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
       if (name == XR_SDFG_AUTO_GRASP_EXTENSION_NAME) continue;
       if (name == XR_EXT_HAND_TRACKING_EXTENSION_NAME) continue;
       if (name == XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME && !withMotionRange) continue;
+      if (name == XR_EXT_HAND_TRACKING_DATA_SOURCE_EXTENSION_NAME && !state->runtimeDataSource)
+        continue;
       down.push_back(name.c_str());
     }
     if (state->downstreamHandTracking) down.push_back(XR_EXT_HAND_TRACKING_EXTENSION_NAME);
@@ -174,7 +183,8 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
                   withMotionRange, int(r));
   }
   if (XR_FAILED(r)) return r;
-  state->active = state->appAutoGrasp || state->provideHandTracking || state->stripMotionRange;
+  state->active = state->appAutoGrasp || state->provideHandTracking || state->stripMotionRange ||
+                  (state->appDataSource && !state->runtimeDataSource);
 
   state->handle = *instance;
   state->next.load(state->nextGipa, *instance);

@@ -198,6 +198,9 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
   SDFG_VERIFY(cmd, (arrays != nullptr) != (buffers != nullptr), XR_ERROR_VALIDATION_FAILURE,
               "(createInfo->next) must chain exactly one XrGraspTargetVerticesSDFG or "
               "XrGraspTargetVulkanBuffersSDFG");
+  const auto* settings = findInChain<const XrGraspTargetSettingsSDFG>(
+      createInfo->next, XR_TYPE_GRASP_TARGET_SETTINGS_SDFG);
+  if (XrResult r = verifyTargetSettings(cmd, settings); r != XR_SUCCESS) return r;
   std::lock_guard lock(s->mutex);
   SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
   if (XrResult r = verifyPlacement(cmd, *s, &createInfo->placement); r != XR_SUCCESS) return r;
@@ -208,6 +211,7 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
     t->space = createInfo->placement.space;
     t->pose = createInfo->placement.pose;
     if (XrResult r = createBufferTarget(cmd, *s, buffers, *t); r != XR_SUCCESS) return r;
+    applyTargetSettings(*s, t->handle, settings);
     s->targets[t->handle] = t;
     *target = fromKey<XrGraspTargetSDFG>(t->handle);
     const uint64_t handle = t->handle;
@@ -228,6 +232,7 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
   t->indexCount = arrays->indexCount;
   if (Status st = s->grasp->addTarget(t->handle, *mesh); st != Status::ok)
     return logError(toXrResult(st), cmd, "the target could not be built (%s)", toString(st));
+  applyTargetSettings(*s, t->handle, settings);
   s->targets[t->handle] = t;
   *target = fromKey<XrGraspTargetSDFG>(t->handle);
   const uint64_t handle = t->handle;

@@ -60,6 +60,14 @@ XrResult XRAPI_CALL SdfgXrPollEvent(XrInstance, XrEventDataBuffer*);
 void noteGraspChange(SessionState& session, Hand hand, bool wasGrasping, uint64_t wasTarget,
                      bool destroyed = false);
 
+// target_settings.cpp: xrSetGraspTargetSettingsSDFG; the check of a settings struct (null: none
+// given, fine) and its application to a new target (the caller holds session.mutex).
+XrResult XRAPI_CALL SdfgXrSetGraspTargetSettingsSDFG(XrGraspTargetSDFG,
+                                                     const XrGraspTargetSettingsSDFG*);
+XrResult verifyTargetSettings(const char* cmd, const XrGraspTargetSettingsSDFG* settings);
+void applyTargetSettings(SessionState& session, uint64_t target,
+                         const XrGraspTargetSettingsSDFG* settings);
+
 // input.cpp: creates the layer's action set and actions on a new instance.
 void createLayerActions(InstanceState& instance);
 // hands.cpp: destroys the layer's internal trackers of a session (before it goes away).

@@ -314,6 +314,7 @@ const Route kRoutes[] = {
     SDFG_ROUTE(XrSetGraspTargetPlacementSDFG, Gate::autoGrasp),
     SDFG_ROUTE(XrGetGraspStateSDFG, Gate::autoGrasp),
     SDFG_ROUTE(XrSetGraspOptionsSDFG, Gate::autoGrasp),
+    SDFG_ROUTE(XrSetGraspTargetSettingsSDFG, Gate::autoGrasp),
 };
 
 XrResult XRAPI_CALL SdfgXrGetInstanceProcAddr(XrInstance instance, const char* name,

@@ -214,6 +214,7 @@ typedef XrResult(XRAPI_PTR* PFN_xrSetGraspOptionsSDFG)(XrSession session,
 #define XR_TYPE_GRASP_CONTACTS_SDFG ((XrStructureType)1009900010)
 #define XR_TYPE_GRASP_HELD_POSE_SDFG ((XrStructureType)1009900011)
 #define XR_TYPE_EVENT_DATA_GRASP_CHANGED_SDFG ((XrStructureType)1009900012)
+#define XR_TYPE_GRASP_TARGET_SETTINGS_SDFG ((XrStructureType)1009900013)
 
 // The part of a finger that touches. The layer models each finger as spheres along its bones
 // (radii interpolated between the joints' XrHandJointLocationEXT::radius).
@@ -300,6 +301,34 @@ typedef struct XrEventDataGraspChangedSDFG {
   XrGraspChangeReasonSDFG reason;
   XrTime time;  // the predicted display time of the frame in which it changed
 } XrEventDataGraspChangedSDFG;
+
+// Which hands may grasp a target.
+typedef XrFlags64 XrGraspHandFlagsSDFG;
+static const XrGraspHandFlagsSDFG XR_GRASP_HAND_LEFT_BIT_SDFG = 0x00000001;
+static const XrGraspHandFlagsSDFG XR_GRASP_HAND_RIGHT_BIT_SDFG = 0x00000002;
+
+// Settings of one target: chained on XrGraspTargetCreateInfoSDFG::next (without it a target is
+// graspable by both hands), or changed with xrSetGraspTargetSettingsSDFG (from the next
+// xrSyncActions; a hand holding the target that may no longer grasp it lets go, with a
+// XR_GRASP_CHANGE_REASON_RELEASED_SDFG event).
+// Which target a grab takes when several are in the hand's grab box: among the targets that hand
+// may grasp whose bounds overlap the grab box (the bounds are the mesh's axis-aligned bounding
+// box in the target frame, or XrGraspTargetVulkanBuffersSDFG's bounds, placed where the target
+// is), the one whose bounds' centre is nearest the grab box's centre; between equally near
+// targets the choice is unspecified. A grasp keeps its target until it ends.
+typedef struct XrGraspTargetSettingsSDFG {
+  XrStructureType type;  // XR_TYPE_GRASP_TARGET_SETTINGS_SDFG
+  const void* XR_MAY_ALIAS next;
+  // XR_GRASP_HAND_LEFT_BIT_SDFG, XR_GRASP_HAND_RIGHT_BIT_SDFG, both, or 0: not graspable for now.
+  // Other bits: XR_ERROR_VALIDATION_FAILURE.
+  XrGraspHandFlagsSDFG graspableBy;
+} XrGraspTargetSettingsSDFG;
+
+// Changes a target's settings. Errors: XR_ERROR_HANDLE_INVALID (target),
+// XR_ERROR_VALIDATION_FAILURE (null, wrong type, unknown bits in graspableBy); nothing changes
+// then.
+typedef XrResult(XRAPI_PTR* PFN_xrSetGraspTargetSettingsSDFG)(
+    XrGraspTargetSDFG target, const XrGraspTargetSettingsSDFG* settings);
 
 #ifdef __cplusplus
 }

@@ -141,7 +141,14 @@ void GraspSession::release(Hand hand) {
   hands_[size_t(hand)].grasp = HandGrasp{};
 }
 
-std::optional<uint64_t> GraspSession::pickTarget(const Pose& worldFromWrist,
+Status GraspSession::setTargetHands(uint64_t id, bool left, bool right) {
+  auto it = targets_.find(id);
+  if (it == targets_.end()) return Status::invalid_argument;
+  it->second.hands = {left, right};
+  return Status::ok;
+}
+
+std::optional<uint64_t> GraspSession::pickTarget(Hand side, const Pose& worldFromWrist,
                                                  std::span<const TargetFrame> targets) const {
   const GridBox& box = settings_.box;
   const Pose boxFromWorld = (worldFromWrist * box.handFromBox).inverse();
@@ -150,7 +157,7 @@ std::optional<uint64_t> GraspSession::pickTarget(const Pose& worldFromWrist,
   float bestDistance = std::numeric_limits<float>::infinity();
   for (const TargetFrame& t : targets) {
     auto it = targets_.find(t.id);
-    if (!t.valid || it == targets_.end()) continue;
+    if (!t.valid || it == targets_.end() || !it->second.hands[size_t(side)]) continue;
     const Pose boxFromObject = boxFromWorld * t.worldFromObject;
     // The target's bounds, as a box-space AABB of its 8 corners, must overlap the grab box.
     glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
@@ -266,7 +273,8 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   const Status collected = collect(hand, slot);
   if (hand.grasp.holding) {
     auto it = targets_.find(hand.grasp.target);
-    if (it == targets_.end() || hand.squeeze < settings_.grabThreshold * settings_.releaseRatio) {
+    if (it == targets_.end() || !it->second.hands[slot] ||
+        hand.squeeze < settings_.grabThreshold * settings_.releaseRatio) {
       cancelPending(hand, slot);
       hand.grasp = HandGrasp{};
       return collected;
@@ -294,7 +302,7 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   }
 
   if (!frame.valid || hand.squeeze < settings_.grabThreshold) return collected;
-  const std::optional<uint64_t> id = pickTarget(frame.worldFromWrist, targets);
+  const std::optional<uint64_t> id = pickTarget(side, frame.worldFromWrist, targets);
   if (!id) return collected;
   const Target& target = targets_.at(*id);
   const TargetFrame* located = nullptr;

@@ -119,6 +119,10 @@ class GraspSession {
   Status updateTargetBounds(uint64_t id, const Aabb& bounds);
   // New positions, same count; a hand holding the target re-solves at its next update.
   Status updateTargetVertices(uint64_t id, std::span<const glm::vec3> positions);
+  // Which hands may grasp the target (both by default; neither: not graspable for now). A hand
+  // holding it that may no longer lets go at its next update. Errors: invalid_argument (unknown
+  // id).
+  Status setTargetHands(uint64_t id, bool left, bool right);
   // Removes the target; a hand holding it lets go. Returns false for an unknown id.
   bool removeTarget(uint64_t id);
   bool hasTarget(uint64_t id) const { return targets_.count(id) != 0; }
@@ -155,6 +159,7 @@ class GraspSession {
     std::unique_ptr<MeshDistance> distance;  // null for device targets
     Aabb bounds;
     uint64_t version = 0;
+    std::array<bool, 2> hands{true, true};  // graspable by the left, the right hand
   };
   struct HandState {
     HandModel model;
@@ -181,7 +186,10 @@ class GraspSession {
   // Collects the hand's deferred build, if any; on a device failure redoes it on the CPU.
   Status collect(HandState& hand, size_t slot);
   void cancelPending(HandState& hand, size_t slot);
-  std::optional<uint64_t> pickTarget(const Pose& worldFromWrist,
+  // The target a grab of `side` takes: among those the hand may grasp whose bounds overlap the
+  // grab box, the one whose bounds' centre is nearest the box's centre (ties: the first in
+  // `targets`).
+  std::optional<uint64_t> pickTarget(Hand side, const Pose& worldFromWrist,
                                      std::span<const TargetFrame> targets) const;
 
   std::unique_ptr<SdfBackend> backend_;

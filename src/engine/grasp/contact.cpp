@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <span>
 
 #include <glm/geometric.hpp>
@@ -11,6 +12,9 @@ namespace {
 
 // A touching sphere this close to its bone's end is that joint's own sphere.
 constexpr float kJointEnd = 1e-3f;
+// Search bound of the mesh query: a touching sphere's centre is about its radius (under 2 cm)
+// from the surface.
+constexpr float kNearBound = 0.05f;  // metres
 
 glm::vec3 faceNormal(const TriangleMesh& m, uint32_t triangle) {
   const glm::vec3& a = m.positions[m.indices[3 * size_t(triangle)]];
@@ -49,14 +53,26 @@ FingerContacts computeContacts(const HandModel& hand, const GraspResult& result,
     c.center = objectFromHand.transformPoint(centreHand);
     if (mesh != nullptr) {
       c.exact = true;
-      const ClosestPoint cp = mesh->closest(c.center);
-      const float sign = mesh->signedDistance(c.center) < 0.0f ? -1.0f : 1.0f;
-      c.distance = sign * cp.distance;
-      c.surfacePoint = cp.point;
+      // A touching sphere is within a few millimetres of the surface: the bounded query with
+      // the nearest sheet's sign is cheap (about 1 us, against up to 200 us for the winding
+      // number of an open 100k-triangle mesh); beyond the bound, the full query.
+      glm::vec3 closest(0.0f);
+      uint32_t triangle = 0;
+      float d = mesh->localSignedDistanceNear(
+          c.center, kNearBound, std::numeric_limits<uint32_t>::max(), &closest, &triangle);
+      if (!std::isfinite(d)) {
+        const ClosestPoint cp = mesh->closest(c.center);
+        d = mesh->signedDistance(c.center) < 0.0f ? -cp.distance : cp.distance;
+        closest = cp.point;
+        triangle = cp.triangle;
+      }
+      const float sign = d < 0.0f ? -1.0f : 1.0f;
+      c.distance = d;
+      c.surfacePoint = closest;
       // Outward: from the surface to an outside centre, from an inside centre to the surface.
-      const glm::vec3 away = c.center - cp.point;
+      const glm::vec3 away = c.center - closest;
       const float l = glm::length(away);
-      c.normal = l > 1e-7f ? sign * away / l : faceNormal(mesh->mesh(), cp.triangle);
+      c.normal = l > 1e-7f ? sign * away / l : faceNormal(mesh->mesh(), triangle);
     } else {
       const float d = field->sample(centreHand);
       glm::vec3 g = field->gradient(centreHand);

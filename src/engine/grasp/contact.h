@@ -7,9 +7,11 @@
 // is where the located joints put it, not where an intermediate step of the solver saw it. With
 // a CPU mesh the point, normal and distance come from one exact query of MeshDistance at that
 // centre: the distance is the mesh's exact signed distance at the reported centre (float
-// rounding apart) and the point is the exact closest point. Without one (device-only targets)
-// they come from the grab-box field the solve read: trilinear distance and gradient, off by up
-// to the field's error (millimetres at 16^3 near curved or sharp parts).
+// rounding apart) and the point is the exact closest point. The sign is the nearest sheet's
+// (MeshDistance::localSignedDistanceWithin, as the solver's exact check): on open meshes it
+// differs from the winding-number sign of signedDistance() only near holes. Without one
+// (device-only targets) they come from the grab-box field the solve read: trilinear distance and
+// gradient, off by up to the field's error (millimetres at 16^3 near curved or sharp parts).
 #pragma once
 
 #include <array>

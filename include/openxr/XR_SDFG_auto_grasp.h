@@ -200,7 +200,7 @@ typedef XrResult(XRAPI_PTR* PFN_xrSetGraspOptionsSDFG)(XrSession session,
                                                        const XrGraspOptionsSDFG* options);
 
 // ---------------------------------------------------------------------------------------------
-// Version 2: honest contacts, the held pose, grasp events.
+// Version 2: honest contacts, the held pose, grasp events, per-target settings.
 //
 // Every version 1 struct keeps its layout; a version 1 app runs unchanged. Two version 1 fields
 // are made honest: XrGraspFingerStateSDFG::contactPoint is the centre of the sphere that touches,
@@ -233,10 +233,11 @@ typedef enum XrGraspContactPartSDFG {
 // outward unit normal there, and distance the signed distance at sphereCenter (|distance| is the
 // length from sphereCenter to surfacePoint). For targets with a CPU mesh (isExact true) they come
 // from one exact query of the mesh: distance equals the mesh's exact signed distance at
-// sphereCenter within 0.1 mm. For Vulkan buffer targets (isExact false) they come from the
-// grab-box signed distance field the layer built (trilinear value and gradient), off by up to
-// the field's error: about a millimetre at the default 16^3 resolution, several near sharp
-// edges and thin parts.
+// sphereCenter within 0.1 mm (its sign is the side of the mesh's nearest sheet, which on a mesh
+// with holes can differ from an inside/outside test right next to a hole). For Vulkan buffer
+// targets (isExact false) they come from the grab-box signed distance field the layer built
+// (trilinear value and gradient), off by up to the field's error: about a millimetre at the default
+// 16^3 resolution, several near sharp edges and thin parts.
 typedef struct XrGraspFingerContactSDFG {
   XrGraspContactPartSDFG part;
   XrHandJointEXT joint;      // JOINT_SPHERE: the joint; BONE_CAPSULE: the bone's first joint

@@ -10,6 +10,7 @@ namespace sdfg::layer {
 #define SDFG_NEXT_COMMANDS(X)            \
   X(xrDestroyInstance)                   \
   X(xrGetSystem)                         \
+  X(xrPollEvent)                         \
   X(xrGetSystemProperties)               \
   X(xrCreateSession)                     \
   X(xrDestroySession)                    \

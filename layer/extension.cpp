@@ -211,6 +211,9 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
       createInfo->next, XR_TYPE_GRASP_TARGET_VERTICES_SDFG);
   const auto* buffers = findInChain<const XrGraspTargetVulkanBuffersSDFG>(
       createInfo->next, XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG);
+  const auto* settings = findInChain<const XrGraspTargetSettingsSDFG>(
+      createInfo->next, XR_TYPE_GRASP_TARGET_SETTINGS_SDFG);
+  if (XrResult r = verifyTargetSettings(cmd, settings); r != XR_SUCCESS) return r;
   std::lock_guard lock(s->mutex);
   SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
   if (XrResult r = verifyPlacement(cmd, *s, &createInfo->placement); r != XR_SUCCESS) return r;
@@ -221,6 +224,7 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
     t->space = createInfo->placement.space;
     t->pose = createInfo->placement.pose;
     if (XrResult r = createBufferTarget(cmd, *s, buffers, *t); r != XR_SUCCESS) return r;
+    applyTargetSettings(*s, t->handle, settings);
     s->targets[t->handle] = t;
     *target = fromKey<XrGraspTargetSDFG>(t->handle);
     const uint64_t handle = t->handle;
@@ -251,6 +255,7 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
   t->indexCount = arrays->indexCount;
   if (Status st = s->grasp->addTarget(t->handle, *mesh); st != Status::ok)
     return logError(toXrResult(st), cmd, "the target could not be built (%s)", toString(st));
+  applyTargetSettings(*s, t->handle, settings);
   s->targets[t->handle] = t;
   *target = fromKey<XrGraspTargetSDFG>(t->handle);
   const uint64_t handle = t->handle;
@@ -266,7 +271,14 @@ XrResult XRAPI_CALL SdfgXrDestroyGraspTargetSDFG(XrGraspTargetSDFG target) {
   SDFG_VERIFY(cmd, t != nullptr, XR_ERROR_HANDLE_INVALID, "(target) is not valid");
   std::lock_guard lock(s->mutex);
   // A hand holding it lets go; its fingers return to the user's pose at the next locate.
-  if (s->grasp != nullptr) s->grasp->removeTarget(t->handle);
+  if (s->grasp != nullptr) {
+    for (Hand hand : {Hand::left, Hand::right}) {
+      const HandGrasp& g = s->grasp->grasp(hand);
+      if (g.holding && g.solves > 0 && g.target == t->handle)
+        noteGraspChange(*s, hand, true, t->handle, /*destroyed=*/true);
+    }
+    s->grasp->removeTarget(t->handle);
+  }
 #if SDFG_LAYER_VULKAN
   // Waits for the layer's reads of the app's buffers in flight: the app may free them next.
   if (t->deviceBuffers && s->vulkanBackend != nullptr)
@@ -364,10 +376,16 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
     const FingerState& fs = g.result.fingers[f];
     out.curl = held ? fs.curl : 0.0f;
     out.inContact = held && fs.contact ? XR_TRUE : XR_FALSE;
-    const glm::vec3 p = held ? g.objectFromHand.transformPoint(fs.contactPoint) : glm::vec3(0.0f);
+    // Version 2: the touching sphere's centre and the signed distance there (contact.h).
+    const FingerContact& c = g.contacts[f];
+    const bool honest = held && fs.contact && c.valid;
+    const glm::vec3 p = honest ? c.center
+                        : held ? g.objectFromHand.transformPoint(fs.contactPoint)
+                               : glm::vec3(0.0f);
     out.contactPoint = {p.x, p.y, p.z};
-    out.distance = held ? fs.distance : 0.0f;
+    out.distance = honest ? c.distance : held ? fs.distance : 0.0f;
   }
+  writeGraspStateV2(*s, hand, held, state);
   if (auto* info = findInChain<XrGraspBuildInfoSDFG>(state->next, XR_TYPE_GRASP_BUILD_INFO_SDFG)) {
     const SdfBuildStats& st = s->grasp->buildStats();
     info->graspBackend = !held          ? XR_GRASP_SDF_BACKEND_NONE_SDFG

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "data_source.h"
 #include "intercepts.h"
 #include "log.h"
 #include "state.h"
@@ -122,6 +123,7 @@ void updateGrasps(SessionState& s) {
     JointRadii radii;
     HandFrame frame = trackedFrame(s, h, joints, radii);
     frame.squeeze = s.squeeze[h];
+    frame.time = s.predictedTime;
     if (frame.valid && !squeezeActive) {
       // A tracked hand without a controller grabs by closing: its mean finger curl.
       JointPoses local;
@@ -136,8 +138,12 @@ void updateGrasps(SessionState& s) {
         frame.worldFromWrist = *grip * wristFromGrip(s.grasp->model(hand)).inverse();
       }
     }
+    const HandGrasp& before = s.grasp->grasp(hand);
+    const bool wasGrasping = before.holding && before.solves > 0;
+    const uint64_t wasTarget = before.target;
     if (Status st = s.grasp->update(hand, frame, frames); st != Status::ok)
       SDFG_LOG_WARN(cmd, "grasp solve failed (%s); the hand stays open", toString(st));
+    noteGraspChange(s, hand, wasGrasping, wasTarget);
   }
 }
 
@@ -153,6 +159,10 @@ XrResult XRAPI_CALL SdfgXrCreateHandTrackerEXT(XrSession session,
   t->session = s;
   const bool synthesis = inst.config.synthesis;
   if (!inst.provideHandTracking && !(inst.runtimeSystemLacksHands && synthesis)) {
+    if (XrResult v = readDataSourceInfo(cmd, inst, info, *t); v != XR_SUCCESS) return v;
+    const ChainUnlink unlink(
+        layerAnswersDataSource(inst) && info != nullptr ? &info->next : nullptr,
+        XR_TYPE_HAND_TRACKING_DATA_SOURCE_INFO_EXT);
     const XrResult r = inst.next.xrCreateHandTrackerEXT(session, info, tracker);
     // A system without hands (the extension listed, controllers only) refuses trackers: the
     // layer synthesizes the hands instead, and remembers, so later trackers skip the runtime.
@@ -185,6 +195,7 @@ XrResult XRAPI_CALL SdfgXrCreateHandTrackerEXT(XrSession session,
                     int(info->handJointSet));
   if (!inst.config.synthesis)
     return logError(XR_ERROR_FEATURE_UNSUPPORTED, cmd, "hand synthesis is switched off");
+  if (XrResult v = readDataSourceInfo(cmd, inst, info, *t); v != XR_SUCCESS) return v;
   t->handle = newLayerHandle();
   t->hand = handOf(info->hand);
   *tracker = fromKey<XrHandTrackerEXT>(t->handle);
@@ -233,6 +244,9 @@ XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT tracker,
 
   if (t->runtimeHandle != XR_NULL_HANDLE) {
     XrResult r;
+    ChainUnlink unlink(
+        layerAnswersDataSource(inst) && locations != nullptr ? &locations->next : nullptr,
+        XR_TYPE_HAND_TRACKING_DATA_SOURCE_STATE_EXT);
     if (inst.stripMotionRange && info != nullptr &&
         findInChain<const XrBaseInStructure>(info->next,
                                              XR_TYPE_HAND_JOINTS_MOTION_RANGE_INFO_EXT)) {
@@ -243,6 +257,9 @@ XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT tracker,
     } else {
       r = inst.next.xrLocateHandJointsEXT(t->runtimeHandle, info, locations);
     }
+    unlink.restore();
+    if (r == XR_SUCCESS)
+      writeDataSourceState(inst, *t, locations, XR_HAND_TRACKING_DATA_SOURCE_UNOBSTRUCTED_EXT);
     if (r != XR_SUCCESS || !locations->isActive) return r;
     try {
       std::lock_guard lock(s->mutex);
@@ -320,7 +337,10 @@ XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT tracker,
       v.angularVelocity = {0, 0, 0};
     }
   }
-  if (!active) {
+  if (!active || (layerAnswersDataSource(inst) && !t->allowController)) {
+    // No grip, or the app does not accept joints synthesized from a controller.
+    locations->isActive = XR_FALSE;
+    writeDataSourceState(inst, *t, locations, XR_HAND_TRACKING_DATA_SOURCE_CONTROLLER_EXT);
     for (auto& l : std::span(locations->jointLocations, XR_HAND_JOINT_COUNT_EXT)) {
       l.locationFlags = 0;
       l.pose = XrPosef{{0, 0, 0, 1}, {0, 0, 0}};
@@ -348,6 +368,7 @@ XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT tracker,
     l.radius = radii[j];
     l.locationFlags = kAllBits;
   }
+  writeDataSourceState(inst, *t, locations, XR_HAND_TRACKING_DATA_SOURCE_CONTROLLER_EXT);
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)
 }

@@ -49,6 +49,25 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession, const XrGraspStateGetInfo
                                             XrGraspStateSDFG*);
 XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession, const XrGraspOptionsSDFG*);
 
+// grasp_output.cpp: fills the version 2 structs chained on an XrGraspStateSDFG (contacts, held
+// pose) for a hand; `held` as isGrasping. The caller holds session.mutex.
+void writeGraspStateV2(const SessionState& session, Hand hand, bool held, XrGraspStateSDFG* state);
+
+// events.cpp: xrPollEvent with the layer's grasp events, and the event of a hand whose grasp
+// changed since it was `wasGrasping` `wasTarget` (`destroyed`: its target is being destroyed).
+// The caller holds session.mutex.
+XrResult XRAPI_CALL SdfgXrPollEvent(XrInstance, XrEventDataBuffer*);
+void noteGraspChange(SessionState& session, Hand hand, bool wasGrasping, uint64_t wasTarget,
+                     bool destroyed = false);
+
+// target_settings.cpp: xrSetGraspTargetSettingsSDFG; the check of a settings struct (null: none
+// given, fine) and its application to a new target (the caller holds session.mutex).
+XrResult XRAPI_CALL SdfgXrSetGraspTargetSettingsSDFG(XrGraspTargetSDFG,
+                                                     const XrGraspTargetSettingsSDFG*);
+XrResult verifyTargetSettings(const char* cmd, const XrGraspTargetSettingsSDFG* settings);
+void applyTargetSettings(SessionState& session, uint64_t target,
+                         const XrGraspTargetSettingsSDFG* settings);
+
 // input.cpp: creates the layer's action set and actions on a new instance.
 void createLayerActions(InstanceState& instance);
 // hands.cpp: destroys the layer's internal trackers of a session (before it goes away).

@@ -22,6 +22,8 @@ constexpr OwnExtension kOwnExtensions[] = {
     {XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_SDFG_auto_grasp_SPEC_VERSION},
     {XR_EXT_HAND_TRACKING_EXTENSION_NAME, XR_EXT_hand_tracking_SPEC_VERSION},
     {XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME, XR_EXT_hand_joints_motion_range_SPEC_VERSION},
+    {XR_EXT_HAND_TRACKING_DATA_SOURCE_EXTENSION_NAME,
+     XR_EXT_hand_tracking_data_source_SPEC_VERSION},
 };
 
 XrResult XRAPI_CALL SdfgXrGetInstanceProcAddr(XrInstance, const char*, PFN_xrVoidFunction*);
@@ -139,6 +141,7 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
   state->appAutoGrasp = contains(appExtensions, XR_SDFG_AUTO_GRASP_EXTENSION_NAME);
   state->appHandTracking = contains(appExtensions, XR_EXT_HAND_TRACKING_EXTENSION_NAME);
   state->appMotionRange = contains(appExtensions, XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME);
+  state->appDataSource = contains(appExtensions, XR_EXT_HAND_TRACKING_DATA_SOURCE_EXTENSION_NAME);
   state->appDebugUtils = contains(appExtensions, XR_EXT_DEBUG_UTILS_EXTENSION_NAME);
   state->appVulkan2 = contains(appExtensions, XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME);
   const bool appTimespec = contains(appExtensions, XR_KHR_CONVERT_TIMESPEC_TIME_EXTENSION_NAME);
@@ -150,6 +153,9 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
   const std::optional<std::vector<std::string>> offered = chainExtensions(nextInfo);
   const bool offersHandTracking =
       !offered || contains(*offered, XR_EXT_HAND_TRACKING_EXTENSION_NAME);
+  // Only a runtime that says it has the data source (and hand tracking) is sent it.
+  const bool offersDataSource =
+      offered && contains(*offered, XR_EXT_HAND_TRACKING_DATA_SOURCE_EXTENSION_NAME);
   const bool offersMotionRange =
       !offered || contains(*offered, XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME);
   // Grasping needs a time to locate the hands at. A runtime that predicts a display time of 0
@@ -177,6 +183,7 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
     state->provideHandTracking = state->appHandTracking && !withHandTracking;
     state->stripMotionRange = state->appMotionRange && !withMotionRange;
     state->downstreamHandTracking = withHandTracking && wantHandTracking;
+    state->runtimeDataSource = state->appDataSource && withHandTracking && offersDataSource;
     // What goes down: the app's list without the layer's own extensions (the runtime would
     // answer XR_ERROR_EXTENSION_NOT_PRESENT), plus hand tracking when grasping wants it.
     std::vector<const char*> down;
@@ -184,6 +191,8 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
       if (name == XR_SDFG_AUTO_GRASP_EXTENSION_NAME) continue;
       if (name == XR_EXT_HAND_TRACKING_EXTENSION_NAME) continue;
       if (name == XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME && !withMotionRange) continue;
+      if (name == XR_EXT_HAND_TRACKING_DATA_SOURCE_EXTENSION_NAME && !state->runtimeDataSource)
+        continue;
       down.push_back(name.c_str());
     }
     if (state->downstreamHandTracking) down.push_back(XR_EXT_HAND_TRACKING_EXTENSION_NAME);
@@ -209,7 +218,8 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
                   "the controllers' grip pose and squeeze");
   }
   state->active = state->appAutoGrasp || state->provideHandTracking || state->stripMotionRange ||
-                  state->runtimeSystemLacksHands;
+                  state->runtimeSystemLacksHands ||
+                  (state->appDataSource && !state->runtimeDataSource);
   if (state->appDebugUtils && state->next.xrSubmitDebugUtilsMessageEXT != nullptr)
     setDebugUtilsSink(*instance, state->next.xrSubmitDebugUtilsMessageEXT);
   if (state->active) createLayerActions(*state);
@@ -296,6 +306,7 @@ enum class Gate {
   handTracking,  // XR_EXT_hand_tracking commands: enabled by the app; ours when active
   vulkan2,       // XR_KHR_vulkan_enable2 commands: ours when active and the app enabled it
   timespec,      // XR_KHR_convert_timespec_time: the next layer's, unless only the layer enabled it
+  events,        // xrPollEvent: ours when the app enabled XR_SDFG_auto_grasp (its events)
 };
 
 struct Route {
@@ -312,6 +323,7 @@ struct Route {
 const Route kRoutes[] = {
     SDFG_ROUTE(XrGetInstanceProcAddr, Gate::always),
     SDFG_ROUTE(XrDestroyInstance, Gate::always),
+    SDFG_ROUTE(XrPollEvent, Gate::events),
     SDFG_ROUTE(XrGetSystemProperties, Gate::active),
     SDFG_ROUTE(XrCreateSession, Gate::active),
     SDFG_ROUTE(XrDestroySession, Gate::active),
@@ -337,6 +349,7 @@ const Route kRoutes[] = {
     SDFG_ROUTE(XrSetGraspTargetPlacementSDFG, Gate::autoGrasp),
     SDFG_ROUTE(XrGetGraspStateSDFG, Gate::autoGrasp),
     SDFG_ROUTE(XrSetGraspOptionsSDFG, Gate::autoGrasp),
+    SDFG_ROUTE(XrSetGraspTargetSettingsSDFG, Gate::autoGrasp),
 };
 
 XrResult XRAPI_CALL SdfgXrGetInstanceProcAddr(XrInstance instance, const char* name,
@@ -386,6 +399,12 @@ XrResult XRAPI_CALL SdfgXrGetInstanceProcAddr(XrInstance instance, const char* n
       case Gate::timespec:
         // Enabled below only for the layer's own clock: not the app's to call (spec 3.2).
         if (state->layerAddedTimespec) return XR_ERROR_FUNCTION_UNSUPPORTED;
+        break;
+      case Gate::events:
+        if (state->active && state->appAutoGrasp) {
+          *function = route.function;
+          return XR_SUCCESS;
+        }
         break;
       case Gate::handTracking:
         if (!state->appHandTracking) return XR_ERROR_FUNCTION_UNSUPPORTED;

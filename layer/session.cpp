@@ -152,6 +152,7 @@ XrResult XRAPI_CALL SdfgXrDestroySession(XrSession session) {
     s->targets.clear();
     s->grasp.reset();
     sessions().erase(key(session));
+    s->instance->events.dropSession(session);  // its grasp events would name a dead handle
   }
   return r;
   SDFG_ENTRY_END(cmd)

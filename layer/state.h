@@ -15,6 +15,7 @@
 
 #include "config.h"
 #include "dispatch.h"
+#include "events.h"
 #include "grasp/grasp_session.h"
 #include "hand/hand_synthesis.h"
 #include "xr_includes.h"
@@ -79,6 +80,10 @@ struct InstanceState {
   // The app enabled XR_EXT_hand_joints_motion_range but the runtime lacks it: stripped, and its
   // struct unlinked from locate calls.
   bool stripMotionRange = false;
+  // XR_EXT_hand_tracking_data_source: enabled by the app; taken by the runtime (it has hand
+  // tracking and the extension), else answered by the layer (data_source.h).
+  bool appDataSource = false;
+  bool runtimeDataSource = false;
   // Any of the above: the layer intercepts. Otherwise it hands out the next layer's functions
   // and the app runs exactly as without it.
   bool active = false;
@@ -103,6 +108,9 @@ struct InstanceState {
   std::unordered_map<uint64_t, PFN_vkGetInstanceProcAddr> vulkanGipa;  // by VkInstance
   VkInstance lastVulkanInstance = VK_NULL_HANDLE;
   std::unordered_map<uint64_t, ExtraQueue> extraQueues;  // by VkDevice
+
+  // XR_SDFG_auto_grasp version 2: the layer's events waiting for xrPollEvent (events.cpp).
+  EventQueue events;
 };
 
 struct TargetState;
@@ -148,6 +156,9 @@ struct TrackerState {
   std::weak_ptr<SessionState> session;
   Hand hand = Hand::left;
   XrHandTrackerEXT runtimeHandle = XR_NULL_HANDLE;  // null: synthesized by the layer
+  // XR_EXT_hand_tracking_data_source sources the app accepts (data_source.h); both by default.
+  bool allowUnobstructed = true;
+  bool allowController = true;
 };
 
 struct TargetState {

@@ -11,3 +11,4 @@
 #include <openxr/openxr_platform.h>
 
 #include <openxr/XR_SDFG_auto_grasp.h>
+#include <openxr/sdfg_hand_tracking_data_source.h>

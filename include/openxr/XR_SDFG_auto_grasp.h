@@ -40,7 +40,7 @@ extern "C" {
 #endif
 
 #define XR_SDFG_auto_grasp 1
-#define XR_SDFG_auto_grasp_SPEC_VERSION 1
+#define XR_SDFG_auto_grasp_SPEC_VERSION 2
 #define XR_SDFG_AUTO_GRASP_EXTENSION_NAME "XR_SDFG_auto_grasp"
 
 XR_DEFINE_HANDLE(XrGraspTargetSDFG)
@@ -250,6 +250,138 @@ typedef XrResult(XRAPI_PTR* PFN_xrGetGraspStateSDFG)(XrSession session,
 // OUT_OF_MEMORY, RUNTIME_FAILURE.
 typedef XrResult(XRAPI_PTR* PFN_xrSetGraspOptionsSDFG)(XrSession session,
                                                        const XrGraspOptionsSDFG* options);
+
+// ---------------------------------------------------------------------------------------------
+// Version 2: honest contacts, the held pose, grasp events, per-target settings.
+//
+// Every version 1 struct keeps its layout; a version 1 app runs unchanged. Two version 1 fields
+// are made honest: XrGraspFingerStateSDFG::contactPoint is the centre of the sphere that touches,
+// whichever joint's or bone's it is (with the whole-finger solver often a pad or a proximal
+// phalanx, not the fingertip), and XrGraspFingerStateSDFG::distance is the target's signed
+// distance at that centre (for targets with a CPU mesh: the exact distance of the mesh, within
+// 0.1 mm; for Vulkan buffer targets: the grab-box field's, see XrGraspFingerContactSDFG).
+// Structure type values of version 2: 1009900010..1009900039.
+// ---------------------------------------------------------------------------------------------
+
+#define XR_TYPE_GRASP_CONTACTS_SDFG ((XrStructureType)1009900010)
+#define XR_TYPE_GRASP_HELD_POSE_SDFG ((XrStructureType)1009900011)
+#define XR_TYPE_EVENT_DATA_GRASP_CHANGED_SDFG ((XrStructureType)1009900012)
+#define XR_TYPE_GRASP_TARGET_SETTINGS_SDFG ((XrStructureType)1009900013)
+
+// The part of a finger that touches. The layer models each finger as spheres along its bones
+// (radii interpolated between the joints' XrHandJointLocationEXT::radius).
+typedef enum XrGraspContactPartSDFG {
+  XR_GRASP_CONTACT_PART_NONE_SDFG = 0,          // the finger touches nothing
+  XR_GRASP_CONTACT_PART_JOINT_SPHERE_SDFG = 1,  // the sphere of `joint` (a tip: the fingertip)
+  XR_GRASP_CONTACT_PART_BONE_CAPSULE_SDFG = 2,  // a point of the capsule of the bone from `joint`
+                                                // to the next joint toward the tip
+  XR_GRASP_CONTACT_PART_MAX_ENUM_SDFG = 0x7FFFFFFF
+} XrGraspContactPartSDFG;
+
+// Where one finger touches. All points and vectors are in the target frame (the frame of the
+// target's vertices, metres), at the solve whose curls the returned joints show; everything is
+// zero when part is XR_GRASP_CONTACT_PART_NONE_SDFG. The fields agree with each other:
+// surfacePoint is the closest point of the target's surface to sphereCenter, surfaceNormal the
+// outward unit normal there, and distance the signed distance at sphereCenter (|distance| is the
+// length from sphereCenter to surfacePoint). For targets with a CPU mesh (isExact true) they come
+// from one exact query of the mesh: distance equals the mesh's exact signed distance at
+// sphereCenter within 0.1 mm (its sign is the side of the mesh's nearest sheet, which on a mesh
+// with holes can differ from an inside/outside test right next to a hole). For Vulkan buffer
+// targets (isExact false) they come from the grab-box signed distance field the layer built
+// (trilinear value and gradient), off by up to the field's error: about a millimetre at the default
+// 16^3 resolution, several near sharp edges and thin parts.
+typedef struct XrGraspFingerContactSDFG {
+  XrGraspContactPartSDFG part;
+  XrHandJointEXT joint;      // JOINT_SPHERE: the joint; BONE_CAPSULE: the bone's first joint
+  float boneFraction;        // BONE_CAPSULE: where along the bone, 0 at `joint` .. 1; else 0
+  float sphereRadius;        // metres: the finger's radius at the touching point
+  XrVector3f sphereCenter;   // target frame: the touching sphere's centre (= contactPoint)
+  XrVector3f surfacePoint;   // target frame: the closest point of the target's surface
+  XrVector3f surfaceNormal;  // target frame, unit: the surface's outward normal at surfacePoint
+  float distance;            // metres, signed (negative inside) at sphereCenter; about
+                             // sphereRadius when the finger rests on the surface
+  XrBool32 isExact;          // from the exact mesh distance (XR_FALSE: from the SDF field)
+} XrGraspFingerContactSDFG;
+
+// Optional output, chained on XrGraspStateSDFG::next. Fingers in thumb, index, middle, ring,
+// little order; all parts NONE when the hand is not grasping.
+typedef struct XrGraspContactsSDFG {
+  XrStructureType type;  // XR_TYPE_GRASP_CONTACTS_SDFG
+  void* XR_MAY_ALIAS next;
+  XrGraspFingerContactSDFG fingers[XR_GRASP_FINGER_COUNT_SDFG];
+} XrGraspContactsSDFG;
+
+// Optional output, chained on XrGraspStateSDFG::next: where the held target is relative to the
+// hand, to attach it. palmFromTarget is the pose of the target frame in the frame of the hand's
+// XR_HAND_JOINT_PALM_EXT joint (metres), as the grasp the returned joints show was solved: to
+// carry the target, place it at (palm joint pose located at any time) * palmFromTarget. `time`
+// is the XrTime the hand and target poses of that solve were located at (the predicted display
+// time of the frame whose xrSyncActions solved it). isValid is XR_FALSE (and the pose identity,
+// time 0) when the hand is not grasping.
+typedef struct XrGraspHeldPoseSDFG {
+  XrStructureType type;  // XR_TYPE_GRASP_HELD_POSE_SDFG
+  void* XR_MAY_ALIAS next;
+  XrBool32 isValid;
+  XrPosef palmFromTarget;
+  XrTime time;
+} XrGraspHeldPoseSDFG;
+
+// Why a grasp changed.
+typedef enum XrGraspChangeReasonSDFG {
+  XR_GRASP_CHANGE_REASON_GRABBED_SDFG = 1,   // a grasp began: its first solved pose is applied
+  XR_GRASP_CHANGE_REASON_RELEASED_SDFG = 2,  // the grab input was released (squeeze below the
+                                             // release threshold), the hand was lost or the
+                                             // solve failed
+  XR_GRASP_CHANGE_REASON_TARGET_DESTROYED_SDFG = 3,  // the app destroyed the held target
+  XR_GRASP_CHANGE_REASON_MAX_ENUM_SDFG = 0x7FFFFFFF
+} XrGraspChangeReasonSDFG;
+
+// An event returned by xrPollEvent (only to apps that enabled XR_SDFG_auto_grasp) when a hand's
+// grasp starts or ends, that is when xrGetGraspStateSDFG's isGrasping changes. It fits in
+// XrEventDataBuffer. Order: the layer keeps its events in a queue per instance (the oldest are
+// dropped beyond 64) and interleaves them with the runtime's by time: a layer event is returned
+// before a runtime event only when its `time` is earlier than the runtime event's own time
+// (XrEventDataSessionStateChanged::time, XrEventDataReferenceSpaceChangePending::changeTime,
+// XrEventDataInstanceLossPending::lossTime); runtime events without a time come first. Events of
+// a session are dropped when it is destroyed.
+typedef struct XrEventDataGraspChangedSDFG {
+  XrStructureType type;  // XR_TYPE_EVENT_DATA_GRASP_CHANGED_SDFG
+  const void* XR_MAY_ALIAS next;
+  XrSession session;
+  XrHandEXT hand;
+  XrGraspTargetSDFG target;  // the target grasped or let go (a destroyed one's former handle)
+  XrBool32 isGrasping;       // XR_TRUE: the grasp began; XR_FALSE: it ended
+  XrGraspChangeReasonSDFG reason;
+  XrTime time;  // the predicted display time of the frame in which it changed
+} XrEventDataGraspChangedSDFG;
+
+// Which hands may grasp a target.
+typedef XrFlags64 XrGraspHandFlagsSDFG;
+static const XrGraspHandFlagsSDFG XR_GRASP_HAND_LEFT_BIT_SDFG = 0x00000001;
+static const XrGraspHandFlagsSDFG XR_GRASP_HAND_RIGHT_BIT_SDFG = 0x00000002;
+
+// Settings of one target: chained on XrGraspTargetCreateInfoSDFG::next (without it a target is
+// graspable by both hands), or changed with xrSetGraspTargetSettingsSDFG (from the next
+// xrSyncActions; a hand holding the target that may no longer grasp it lets go, with a
+// XR_GRASP_CHANGE_REASON_RELEASED_SDFG event).
+// Which target a grab takes when several are in the hand's grab box: among the targets that hand
+// may grasp whose bounds overlap the grab box (the bounds are the mesh's axis-aligned bounding
+// box in the target frame, or XrGraspTargetVulkanBuffersSDFG's bounds, placed where the target
+// is), the one whose bounds' centre is nearest the grab box's centre; between equally near
+// targets the choice is unspecified. A grasp keeps its target until it ends.
+typedef struct XrGraspTargetSettingsSDFG {
+  XrStructureType type;  // XR_TYPE_GRASP_TARGET_SETTINGS_SDFG
+  const void* XR_MAY_ALIAS next;
+  // XR_GRASP_HAND_LEFT_BIT_SDFG, XR_GRASP_HAND_RIGHT_BIT_SDFG, both, or 0: not graspable for now.
+  // Other bits: XR_ERROR_VALIDATION_FAILURE.
+  XrGraspHandFlagsSDFG graspableBy;
+} XrGraspTargetSettingsSDFG;
+
+// Changes a target's settings. Errors: XR_ERROR_HANDLE_INVALID (target),
+// XR_ERROR_VALIDATION_FAILURE (null, wrong type, unknown bits in graspableBy); nothing changes
+// then.
+typedef XrResult(XRAPI_PTR* PFN_xrSetGraspTargetSettingsSDFG)(
+    XrGraspTargetSDFG target, const XrGraspTargetSettingsSDFG* settings);
 
 #ifdef __cplusplus
 }

@@ -439,3 +439,52 @@ TEST_CASE("Destroying a session while its pipelines are being made neither hangs
     CHECK(vulkanMessages().size() == messagesBefore);
   }
 }
+
+// XR_SDFG_auto_grasp version 2 on a target that exists only in the app's Vulkan buffers: the
+// layer has no CPU mesh, so each finger's contact comes from the grab-box field, says so, and
+// is still consistent with itself and near the analytic sphere (the field's error, not 0.1 mm).
+TEST_CASE("Contacts on a Vulkan buffer target come from the field and say so", "[layer][vulkan]") {
+  if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+  const XrVector3f centre = boxCentreInLocal(grip, /*right=*/true);
+  const float radius = 0.04f;
+  const TestMesh sphere = makeIcosphere(radius, 3);
+  applyEnv(squeezeEnv(grip));
+  {
+    App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME},
+             true,
+             Graphics::vulkan2});
+    REQUIRE(app.ok());
+    Ext ext(app);
+    BufferMesh m = uploadMesh(app, sphere, 1.0f);
+    XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &m.desc};
+    ci.placement = {
+        XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, app.local, {{0, 0, 0, 1}, centre}};
+    XrGraspTargetSDFG t = XR_NULL_HANDLE;
+    REQUIRE(ext.create(app.session, &ci, &t) == XR_SUCCESS);
+    REQUIRE(runUntilGrasping(app, ext).state.isGrasping);
+    XrGraspContactsSDFG contacts{XR_TYPE_GRASP_CONTACTS_SDFG};
+    XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG, &contacts};
+    XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
+    REQUIRE(ext.state(app.session, &gi, &st) == XR_SUCCESS);
+    int touching = 0;
+    for (int f = 0; f < 5; ++f) {
+      const XrGraspFingerContactSDFG& c = contacts.fingers[f];
+      CAPTURE(f, c.distance, c.sphereRadius);
+      if (!st.fingers[f].inContact) continue;
+      ++touching;
+      REQUIRE(c.part != XR_GRASP_CONTACT_PART_NONE_SDFG);
+      CHECK(c.isExact == XR_FALSE);
+      CHECK(std::memcmp(&c.sphereCenter, &st.fingers[f].contactPoint, sizeof(XrVector3f)) == 0);
+      const float r = length(c.sphereCenter);  // the sphere's centre is the target's origin
+      CHECK(std::abs(length(sub(c.sphereCenter, c.surfacePoint)) - std::abs(c.distance)) < 1e-5f);
+      // The 16^3 field's error on a sphere: well under 2 mm.
+      CHECK(std::abs(c.distance - (r - radius)) < 0.002f);
+      const XrVector3f& n = c.surfaceNormal;
+      CHECK((n.x * c.sphereCenter.x + n.y * c.sphereCenter.y + n.z * c.sphereCenter.z) / r > 0.95f);
+    }
+    CHECK(touching >= 3);
+    REQUIRE(ext.destroy(t) == XR_SUCCESS);
+  }
+  CHECK(validationLog().empty());
+}

@@ -378,6 +378,7 @@ void App::destroySession() {
 void App::pollEvents() {
   XrEventDataBuffer e{XR_TYPE_EVENT_DATA_BUFFER};
   while (xrPollEvent(instance, &e) == XR_SUCCESS) {
+    events.push_back(e);
     if (e.type == XR_TYPE_EVENT_DATA_SESSION_STATE_CHANGED) {
       const auto* s = reinterpret_cast<XrEventDataSessionStateChanged*>(&e);
       if (s->state == XR_SESSION_STATE_READY) {

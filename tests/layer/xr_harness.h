@@ -86,6 +86,7 @@ class App {
   XrTime lastTime = 0;
   uint64_t framesEnded = 0;
   XrResult lastSync = XR_SUCCESS;
+  std::vector<XrEventDataBuffer> events;  // every event frame() polled, in order
 
   template <class F>
   F fn(const char* name) const {

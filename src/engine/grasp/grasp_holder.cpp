@@ -53,6 +53,8 @@ void GraspHolder::step(const FingerCurls& userCurls, float dt) {
     s.contact = t.contact;
     s.contactPoint = t.contactPoint;
     s.distance = t.distance;
+    s.contactBone = t.contactBone;
+    s.contactT = t.contactT;
   }
   shown_.handCorrection = target_.handCorrection;
 }

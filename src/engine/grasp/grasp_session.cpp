@@ -148,7 +148,14 @@ void GraspSession::release(Hand hand) {
   hands_[size_t(hand)].grasp = HandGrasp{};
 }
 
-std::optional<uint64_t> GraspSession::pickTarget(const Pose& worldFromWrist,
+Status GraspSession::setTargetHands(uint64_t id, bool left, bool right) {
+  auto it = targets_.find(id);
+  if (it == targets_.end()) return Status::invalid_argument;
+  it->second.hands = {left, right};
+  return Status::ok;
+}
+
+std::optional<uint64_t> GraspSession::pickTarget(Hand side, const Pose& worldFromWrist,
                                                  std::span<const TargetFrame> targets) const {
   const GridBox& box = settings_.box;
   const Pose boxFromWorld = (worldFromWrist * box.handFromBox).inverse();
@@ -157,7 +164,7 @@ std::optional<uint64_t> GraspSession::pickTarget(const Pose& worldFromWrist,
   float bestDistance = std::numeric_limits<float>::infinity();
   for (const TargetFrame& t : targets) {
     auto it = targets_.find(t.id);
-    if (!t.valid || it == targets_.end()) continue;
+    if (!t.valid || it == targets_.end() || !it->second.hands[size_t(side)]) continue;
     const Pose boxFromObject = boxFromWorld * t.worldFromObject;
     // The target's bounds, as a box-space AABB of its 8 corners, must overlap the grab box.
     glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
@@ -198,6 +205,7 @@ Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Targ
       hand.pending = true;
       hand.pendingPose = objectFromHand;
       hand.pendingVersion = target.version;
+      hand.pendingTime = hand.frameTime;
       return Status::ok;
     }
     // Busy with a cancelled build still on the device: ask again at the next update.
@@ -210,11 +218,12 @@ Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Targ
       s != Status::ok)
     return s;
   ++stats_.cpuBuilds;
-  return solveWithGrid(hand, objectFromHand, target.version, false, target.distance.get());
+  return solveWithGrid(hand, objectFromHand, target.version, false, target.distance.get(),
+                       hand.frameTime);
 }
 
 Status GraspSession::solveWithGrid(HandState& hand, const Pose& objectFromHand, uint64_t version,
-                                   bool gpu, const MeshDistance* exactMesh) {
+                                   bool gpu, const MeshDistance* exactMesh, int64_t time) {
   GraspScene scene;
   scene.field = &hand.grid;
   scene.objectFromHand = objectFromHand;
@@ -226,6 +235,8 @@ Status GraspSession::solveWithGrid(HandState& hand, const Pose& objectFromHand, 
   GraspResult result;
   if (Status s = hand.solver->solve(scene, result); s != Status::ok) return s;
   hand.grasp.result = result;
+  hand.grasp.contacts = computeContacts(hand.model, result, objectFromHand, exactMesh, &hand.grid);
+  hand.grasp.time = time;
   hand.grasp.objectFromHand = objectFromHand;
   hand.grasp.builtOnGpu = gpu;
   hand.solvedVersion = version;
@@ -248,7 +259,7 @@ Status GraspSession::collect(HandState& hand, size_t slot) {
     ++stats_.gpuBuilds;
     // A result for older vertices is still shown; the next update asks again.
     return solveWithGrid(hand, hand.pendingPose, hand.pendingVersion, true,
-                         it->second.distance.get());
+                         it->second.distance.get(), hand.pendingTime);
   }
   // The device failed (or lost the request): redo the build on the CPU now.
   if (p == BuildPoll::failed) stats_.gpuFailed = true;
@@ -263,7 +274,7 @@ Status GraspSession::collect(HandState& hand, size_t slot) {
   }
   ++stats_.cpuBuilds;
   return solveWithGrid(hand, hand.pendingPose, hand.pendingVersion, false,
-                       it->second.distance.get());
+                       it->second.distance.get(), hand.pendingTime);
 }
 
 Status GraspSession::update(Hand side, const HandFrame& frame,
@@ -271,10 +282,12 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   const size_t slot = size_t(side);
   HandState& hand = hands_[slot];
   hand.squeeze = std::isfinite(frame.squeeze) ? frame.squeeze : 0.0f;
+  hand.frameTime = frame.time;
   const Status collected = collect(hand, slot);
   if (hand.grasp.holding) {
     auto it = targets_.find(hand.grasp.target);
-    if (it == targets_.end() || hand.squeeze < settings_.grabThreshold * settings_.releaseRatio) {
+    if (it == targets_.end() || !it->second.hands[slot] ||
+        hand.squeeze < settings_.grabThreshold * settings_.releaseRatio) {
       cancelPending(hand, slot);
       hand.grasp = HandGrasp{};
       return collected;
@@ -302,7 +315,7 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   }
 
   if (!frame.valid || hand.squeeze < settings_.grabThreshold) return collected;
-  const std::optional<uint64_t> id = pickTarget(frame.worldFromWrist, targets);
+  const std::optional<uint64_t> id = pickTarget(side, frame.worldFromWrist, targets);
   if (!id) return collected;
   const Target& target = targets_.at(*id);
   const TargetFrame* located = nullptr;

@@ -27,6 +27,7 @@
 #include <string>
 
 #include "base/status.h"
+#include "grasp/contact.h"
 #include "grasp/solver.h"
 #include "hand/hand_model.h"
 #include "mesh/mesh.h"
@@ -61,6 +62,9 @@ struct HandFrame {
   // them when a grab starts. Null for controller-driven hands (the default adult model).
   const JointPoses* trackedJoints = nullptr;
   const std::array<float, kJointCount>* trackedRadii = nullptr;
+  // The caller's time stamp of this frame (the layer: the predicted display time the poses were
+  // located at), handed back as HandGrasp::time of the solves made from it.
+  int64_t time = 0;
 };
 
 struct TargetFrame {
@@ -76,6 +80,10 @@ struct HandGrasp {
   Pose objectFromHand;      // at the last solve
   uint64_t solves = 0;      // how many times this grab was solved
   bool builtOnGpu = false;  // the SDF of the last solve came from the deferred (GPU) backend
+  // Per finger, where it touches the target (target frame), computed at each solve: exact on
+  // targets with a CPU mesh, from the field on device targets (contact.h).
+  FingerContacts contacts{};
+  int64_t time = 0;  // HandFrame::time of the frame whose poses the last solve used
 };
 
 // Where the session's grab-box SDFs were built so far.
@@ -113,6 +121,10 @@ class GraspSession {
   Status updateTargetBounds(uint64_t id, const Aabb& bounds);
   // New positions, same count; a hand holding the target re-solves at its next update.
   Status updateTargetVertices(uint64_t id, std::span<const glm::vec3> positions);
+  // Which hands may grasp the target (both by default; neither: not graspable for now). A hand
+  // holding it that may no longer lets go at its next update. Errors: invalid_argument (unknown
+  // id).
+  Status setTargetHands(uint64_t id, bool left, bool right);
   // Removes the target; a hand holding it lets go. Returns false for an unknown id.
   bool removeTarget(uint64_t id);
   bool hasTarget(uint64_t id) const { return targets_.count(id) != 0; }
@@ -152,6 +164,7 @@ class GraspSession {
     std::unique_ptr<MeshDistance> distance;  // null for device targets
     Aabb bounds;
     uint64_t version = 0;
+    std::array<bool, 2> hands{true, true};  // graspable by the left, the right hand
   };
   struct HandState {
     HandModel model;
@@ -165,17 +178,23 @@ class GraspSession {
     bool pending = false;
     Pose pendingPose;
     uint64_t pendingVersion = 0;
+    int64_t pendingTime = 0;
+    int64_t frameTime = 0;  // HandFrame::time of the update in progress
   };
 
   Status solve(HandState& hand, size_t slot, uint64_t id, const Target& target,
                const Pose& objectFromHand);
-  // `exactMesh`: the target's mesh for the exact check (null: none).
+  // `exactMesh`: the target's mesh for the exact check and the contacts (null: none); `time`:
+  // the HandFrame::time the pose came from.
   Status solveWithGrid(HandState& hand, const Pose& objectFromHand, uint64_t version, bool gpu,
-                       const MeshDistance* exactMesh);
+                       const MeshDistance* exactMesh, int64_t time);
   // Collects the hand's deferred build, if any; on a device failure redoes it on the CPU.
   Status collect(HandState& hand, size_t slot);
   void cancelPending(HandState& hand, size_t slot);
-  std::optional<uint64_t> pickTarget(const Pose& worldFromWrist,
+  // The target a grab of `side` takes: among those the hand may grasp whose bounds overlap the
+  // grab box, the one whose bounds' centre is nearest the box's centre (ties: the first in
+  // `targets`).
+  std::optional<uint64_t> pickTarget(Hand side, const Pose& worldFromWrist,
                                      std::span<const TargetFrame> targets) const;
 
   std::unique_ptr<SdfBackend> backend_;

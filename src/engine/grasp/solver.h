@@ -43,6 +43,12 @@ struct FingerState {
   glm::vec3 contactPoint{
       0.0f};              // hand space: where the finger touches (the stopping sphere's centre)
   float distance = 0.0f;  // the target's distance at contactPoint as the strategy saw it
+  // The touching part, when `contact`: the sphere whose centre is contactPoint lies on the bone
+  // from fingerJoints()[contactBone] to the next joint, at contactT (0 at that joint, 1 at the
+  // next one: the next joint's own sphere). Tip-only strategies report the tip (the last bone,
+  // 1). -1 without a contact. contact.h turns it into the exact contact on the target.
+  int contactBone = -1;
+  float contactT = 1.0f;
 };
 
 struct GraspResult {

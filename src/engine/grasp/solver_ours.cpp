@@ -257,6 +257,8 @@ Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {
       state.contact = true;
       state.contactPoint = point;
       state.distance = value;
+      state.contactBone = fr.spheres[touching].bone;
+      state.contactT = fr.spheres[touching].t;
       firstFree = fr.spheres[touching].bone + 1;
     }
     for (int j = n; j < kMaxJoints; ++j) curls[j] = curls[n - 1];

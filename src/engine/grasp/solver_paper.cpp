@@ -125,6 +125,10 @@ Status PaperSolver::solve(const GraspScene& scene, GraspResult& out) const {
     state.jointCurls.fill(stop.curl);
     state.contact = stop.contact;
     state.distance = stop.distance;
+    if (stop.contact) {
+      state.contactBone = int(fingerJoints(Finger(f)).size()) - 2;  // the tip
+      state.contactT = 1.0f;
+    }
     // On a sample the cached point is exact; between samples the tip is where FK puts it.
     state.contactPoint = stop.curl == params_[stop.sample]
                              ? handTips_[first + stop.sample]

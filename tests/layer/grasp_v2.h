@@ -1,0 +1,126 @@
+// Helpers of the version 2 tests of XR_SDFG_auto_grasp (contacts, held pose, events): a scene
+// that keeps its app alive, frames run until an outcome holds (never a fixed count), and where the
+// open right hand lies (to put objects under its palm).
+#pragma once
+
+#include <catch2/catch.hpp>
+#include <memory>
+#include <string>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "grasp_checks.h"
+#include "test_scenes.h"
+#include "xr_harness.h"
+
+namespace sdfg::test {
+
+// Runs frames until `done()` holds; false if it still does not after `bound` frames.
+template <class F>
+bool runUntil(App& app, F done, int bound = 300) {
+  for (int i = 0; i < bound; ++i) {
+    if (done()) return true;
+    app.frame();
+  }
+  return done();
+}
+
+// A controller-only runtime, one hand squeezing from frame `squeezeFrame` (and releasing at
+// `releaseFrame` when it is not 0), a tracker on it and one target.
+struct GraspRun {
+  std::unique_ptr<App> app;
+  std::unique_ptr<Ext> ext;
+  XrHandEXT hand = XR_HAND_RIGHT_EXT;
+  XrHandTrackerEXT tracker = XR_NULL_HANDLE;
+  XrGraspTargetSDFG target = XR_NULL_HANDLE;
+
+  GraspRun(const TestMesh& mesh, const XrPosef& objectPose, const XrPosef& grip,
+           const char* handName = "right", uint64_t releaseFrame = 0) {
+    XrEnv env;
+    env.handTracking = "absent";
+    env.script = gripLine(0, handName, grip) + squeezeLine(0, handName, 0.0f) +
+                 squeezeLine(4, handName, 0.0f) + squeezeLine(6, handName, 1.0f);
+    if (releaseFrame != 0) env.script += squeezeLine(releaseFrame, handName, 0.0f);
+    applyEnv(env);
+    app = std::make_unique<App>(
+        AppOptions{{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}});
+    REQUIRE(app->ok());
+    ext = std::make_unique<Ext>(*app);
+    hand = std::string(handName) == "left" ? XR_HAND_LEFT_EXT : XR_HAND_RIGHT_EXT;
+    tracker = makeTracker(*app, *ext, hand);
+    target = makeTarget(*app, *ext, mesh, objectPose);
+  }
+
+  XrResult state(XrGraspStateSDFG& out) const {
+    XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, hand};
+    return ext->state(app->session, &gi, &out);
+  }
+  bool grasping() const {
+    XrGraspStateSDFG s{XR_TYPE_GRASP_STATE_SDFG};
+    return state(s) == XR_SUCCESS && s.isGrasping;
+  }
+};
+
+// Where the open right hand driven by `grip` is, in LOCAL space: its palm joint, the palm's
+// normal (out of the palm), the axis across its fingers and the middle finger's knuckle.
+struct OpenRightHand {
+  glm::vec3 palm, down, across, knuckles;
+};
+
+inline OpenRightHand openRightHand(const XrPosef& grip) {
+  const HandModel model = HandModel::defaultAdult(Hand::right);
+  const Pose localFromWrist = toPose(grip) * wristFromGrip(model).inverse();
+  JointPoses open;
+  model.pose(FingerCurls{}, open);
+  const Pose& palm = open[int(Joint::palm)];
+  const glm::vec3 across =
+      open[int(Joint::little_proximal)].position - open[int(Joint::index_proximal)].position;
+  return {localFromWrist.transformPoint(palm.position),
+          localFromWrist.transformVector(palm.orientation * glm::vec3(0, -1, 0)),
+          glm::normalize(localFromWrist.transformVector(across)),
+          localFromWrist.transformPoint(open[int(Joint::middle_proximal)].position)};
+}
+
+// `mesh` turned by `orientation`, shifted by `shift` from the palm joint, and moved along the
+// palm's normal until every sphere of the open right hand is 3 mm clear of it.
+inline XrPosef belowOpenRightPalm(const TestMesh& mesh, const XrPosef& grip,
+                                  const XrQuaternionf& orientation,
+                                  const glm::vec3& shift = glm::vec3(0.0f)) {
+  const HandModel model = HandModel::defaultAdult(Hand::right);
+  const Pose localFromWrist = toPose(grip) * wristFromGrip(model).inverse();
+  const OpenRightHand hand = openRightHand(grip);
+  std::vector<BodySphere> spheres;
+  for (int f = 0; f < kFingerCount; ++f) model.phalanxSpheres(Finger(f), 0.0f, spheres);
+  JointPoses open;
+  model.pose(FingerCurls{}, open);
+  spheres.push_back({open[int(Joint::palm)].position, model.jointRadius(Joint::palm), 0});
+  const ExactDistance atOrigin(mesh, XrPosef{orientation, {0, 0, 0}});
+  for (float s = 0.0f; s < 0.4f; s += 0.002f) {
+    const glm::vec3 t = hand.palm + shift + hand.down * s;
+    bool clear = true;
+    for (const BodySphere& b : spheres) {
+      const glm::vec3 p = localFromWrist.transformPoint(b.center) - t;
+      if (atOrigin({p.x, p.y, p.z}) < b.radius + 0.003f) {
+        clear = false;
+        break;
+      }
+    }
+    if (clear) return XrPosef{orientation, {t.x, t.y, t.z}};
+  }
+  FAIL("no placement under the open palm keeps the hand clear of the mesh");
+  return {};
+}
+
+// The procedural mug's pose in layer_grasp.tests.cpp's mug scene: handle toward the palm, its bar
+// across the base of the fingers.
+inline XrPosef mugUnderRightPalm(const TestMesh& mug, const XrPosef& grip) {
+  const OpenRightHand hand = openRightHand(grip);
+  const glm::vec3 x = -hand.down;
+  const glm::vec3 y = glm::normalize(hand.across - glm::dot(hand.across, x) * x);
+  const glm::quat q = glm::quat_cast(glm::mat3(x, y, glm::cross(x, y)));
+  glm::vec3 toKnuckles = hand.knuckles - hand.palm;
+  toKnuckles -= glm::dot(toKnuckles, hand.down) * hand.down;
+  return belowOpenRightPalm(mug, grip, {q.x, q.y, q.z, q.w}, toKnuckles);
+}
+
+}  // namespace sdfg::test

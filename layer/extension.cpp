@@ -226,7 +226,7 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
   t->pose = createInfo->placement.pose;
   t->vertexCount = arrays->vertexCount;
   t->indexCount = arrays->indexCount;
-  if (Status st = s->grasp->addTarget(t->handle, *mesh); st != Status::ok)
+  if (Status st = s->grasp->addTarget(t->handle, std::move(*mesh)); st != Status::ok)
     return logError(toXrResult(st), cmd, "the target could not be built (%s)", toString(st));
   s->targets[t->handle] = t;
   *target = fromKey<XrGraspTargetSDFG>(t->handle);
@@ -352,6 +352,16 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
     info->cpuBuildCount = st.cpuBuilds;
     info->gpuFailed = st.gpuFailed ? XR_TRUE : XR_FALSE;
     info->pendingGpuBuilds = uint32_t(s->grasp->pendingBuilds());
+  }
+  if (auto* setup = findInChain<XrGraspTargetsSetupInfoSDFG>(
+          state->next, XR_TYPE_GRASP_TARGETS_SETUP_INFO_SDFG)) {
+    setup->readyCount = setup->pendingCount = setup->failedCount = 0;
+    for (const auto& [id, target] : s->targets) {
+      const TargetSetup st = s->grasp->targetSetup(id);
+      if (st == TargetSetup::ready) ++setup->readyCount;
+      if (st == TargetSetup::pending) ++setup->pendingCount;
+      if (st == TargetSetup::failed) ++setup->failedCount;
+    }
   }
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)

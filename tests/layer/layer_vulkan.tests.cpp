@@ -265,8 +265,12 @@ TEST_CASE(
       // processes kept both cores busy; the layer then leaks rather than free objects the GPU
       // may still use, and the validation layer reports them.)
       makeTarget(app, ext, makeIcosphere(0.04f, 4), {{0, 0, 0, 1}, centre});
+      // The target is graspable once the session's worker has set it up; the frame after, the
+      // grab requests its build (an outcome waited for, with a generous bound).
       State s = graspState(app, ext);
-      for (int i = 0; i < 20 && s.build.pendingGpuBuilds == 0; ++i) {
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+      while (s.build.pendingGpuBuilds == 0 && !s.state.isGrasping &&
+             std::chrono::steady_clock::now() < deadline) {
         app.frame();  // the frame's xrEndFrame submits what its xrSyncActions requested
         s = graspState(app, ext);
       }

@@ -1,0 +1,238 @@
+#include "grasp/grasp_worker.h"
+
+#include <new>
+
+namespace sdfg {
+
+GraspWorker::GraspWorker(std::unique_ptr<SdfBackend> backend) : backend_(std::move(backend)) {
+  thread_ = std::thread([this] { run(); });
+}
+
+GraspWorker::~GraspWorker() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  thread_.join();
+}
+
+void GraspWorker::addTarget(uint64_t id, TriangleMesh mesh) {
+  auto t = std::make_shared<Target>();
+  t->setupMesh = std::move(mesh);
+  {
+    std::lock_guard lock(mutex_);
+    targets_[id] = std::move(t);
+    setups_.push_back(id);
+  }
+  wake_.notify_all();
+}
+
+void GraspWorker::updateVertices(uint64_t id, std::vector<glm::vec3> positions, uint64_t version) {
+  std::lock_guard lock(mutex_);
+  auto it = targets_.find(id);
+  if (it == targets_.end()) return;
+  it->second->positions = std::move(positions);
+  it->second->positionsVersion = version;
+}
+
+void GraspWorker::removeTarget(uint64_t id) {
+  std::shared_ptr<Target> dropped;  // freed outside the lock: a big mesh takes a while
+  {
+    std::lock_guard lock(mutex_);
+    auto it = targets_.find(id);
+    if (it == targets_.end()) return;
+    dropped = std::move(it->second);
+    targets_.erase(it);
+  }
+}
+
+GraspWorker::TargetInfo GraspWorker::targetInfo(uint64_t id) const {
+  std::lock_guard lock(mutex_);
+  auto it = targets_.find(id);
+  if (it == targets_.end()) return {};
+  return {it->second->setup, it->second->bounds, it->second->error};
+}
+
+void GraspWorker::request(size_t slot, Job job) {
+  {
+    std::lock_guard lock(mutex_);
+    slots_[slot].queued = std::move(job);
+  }
+  wake_.notify_all();
+}
+
+void GraspWorker::cancel(size_t slot) {
+  std::lock_guard lock(mutex_);
+  Slot& s = slots_[slot];
+  s.queued.reset();
+  s.done.reset();
+  if (s.running) s.cancelledBelow = s.runningTicket + 1;
+}
+
+std::optional<GraspWorker::Done> GraspWorker::take(size_t slot) {
+  std::lock_guard lock(mutex_);
+  std::optional<Done> out = std::move(slots_[slot].done);
+  slots_[slot].done.reset();
+  return out;
+}
+
+bool GraspWorker::waitIdle(std::chrono::milliseconds timeout) const {
+  std::unique_lock lock(mutex_);
+  return idle_.wait_for(lock, timeout, [&] {
+    return !busy_ && setups_.empty() && !slots_[0].queued && !slots_[1].queued;
+  });
+}
+
+uint64_t GraspWorker::setupsDone() const {
+  std::lock_guard lock(mutex_);
+  return setupsDone_;
+}
+
+uint64_t GraspWorker::jobsDone() const {
+  std::lock_guard lock(mutex_);
+  return jobsDone_;
+}
+
+void GraspWorker::run() {
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    wake_.wait(lock,
+               [&] { return stop_ || !setups_.empty() || slots_[0].queued || slots_[1].queued; });
+    if (stop_) break;
+    busy_ = true;
+    if (!setups_.empty()) {
+      // Set-ups first: a target must be ready before any hand can grab it.
+      const uint64_t id = setups_.front();
+      setups_.pop_front();
+      auto it = targets_.find(id);
+      if (it != targets_.end() && it->second->setupMesh) runSetup(lock, id, it->second);
+    } else {
+      // The slots take turns, so one hand's stream of re-solves cannot starve the other's grab.
+      size_t slot = nextSlot_;
+      if (!slots_[slot].queued) slot = 1 - slot;
+      nextSlot_ = 1 - slot;
+      Job job = std::move(*slots_[slot].queued);
+      slots_[slot].queued.reset();
+      runJob(lock, slot, std::move(job));
+    }
+    busy_ = false;
+    if (setups_.empty() && !slots_[0].queued && !slots_[1].queued) idle_.notify_all();
+  }
+  busy_ = false;
+  idle_.notify_all();
+}
+
+void GraspWorker::runSetup(std::unique_lock<std::mutex>& lock, uint64_t id,
+                           std::shared_ptr<Target> target) {
+  TriangleMesh mesh = std::move(*target->setupMesh);
+  target->setupMesh.reset();
+  lock.unlock();
+  std::shared_ptr<MeshDistance> distance;
+  std::string error;
+  Aabb bounds;
+  try {
+    bounds = computeBounds(mesh.positions);
+    auto made = MeshDistance::create(mesh);
+    if (made)
+      distance = std::move(*made);
+    else
+      error = made.error().message;
+  } catch (const std::bad_alloc&) {
+    error = "out of memory";
+  } catch (...) {
+    error = "internal error";
+  }
+  mesh = TriangleMesh{};  // freed before the lock
+  lock.lock();
+  ++setupsDone_;
+  // Removed (or replaced by a new target of the same id) while it was set up: nothing to publish.
+  auto it = targets_.find(id);
+  if (it == targets_.end() || it->second != target) return;
+  if (distance != nullptr) {
+    target->distance = std::move(distance);
+    target->bounds = bounds;
+    target->setup = TargetSetup::ready;
+  } else {
+    target->setup = TargetSetup::failed;
+    target->error = error.empty() ? "the mesh was refused" : error;
+  }
+}
+
+void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job job) {
+  Slot& s = slots_[slot];
+  s.running = true;
+  s.runningTicket = job.ticket;
+  std::shared_ptr<Target> target;
+  std::optional<std::vector<glm::vec3>> positions;
+  uint64_t version = 0;
+  if (auto it = targets_.find(job.target);
+      it != targets_.end() && it->second->setup == TargetSetup::ready) {
+    target = it->second;
+    positions = std::move(target->positions);
+    target->positions.reset();
+    version = positions ? target->positionsVersion : target->appliedVersion;
+  }
+  lock.unlock();
+
+  const auto start = std::chrono::steady_clock::now();
+  Done done;
+  done.ticket = job.ticket;
+  done.objectFromHand = job.objectFromHand;
+  done.version = version;
+  std::optional<Aabb> refitBounds;
+  try {
+    MeshDistance* distance = target != nullptr ? target->distance.get() : nullptr;
+    if (distance != nullptr && positions) {
+      // A deformed mesh: refit the hierarchy (O(n)), as the app's thread did before the worker.
+      done.status = distance->updatePositions(*positions);
+      if (done.status == Status::ok) refitBounds = computeBounds(*positions);
+    }
+    const SdfGrid* field = job.field ? &*job.field : nullptr;
+    if (done.status == Status::ok && field == nullptr) {
+      if (distance == nullptr) {
+        done.status = Status::invalid_argument;  // removed, or not set up
+      } else {
+        done.status = backend_->build(*distance, job.objectFromHand, job.box, grid_);
+        done.built = done.status == Status::ok;
+        field = &grid_;
+      }
+    }
+    if (done.status == Status::ok && job.solver == nullptr) done.status = Status::internal;
+    if (done.status == Status::ok && !job.solver->prepared) {
+      SolverSetup& setup = *job.solver;
+      setup.prepareStatus = setup.solver->prepare(setup.model, setup.box, setup.options);
+      setup.prepared = true;
+    }
+    if (done.status == Status::ok) done.status = job.solver->prepareStatus;
+    if (done.status == Status::ok) {
+      GraspScene scene;
+      scene.field = field;
+      scene.objectFromHand = job.objectFromHand;
+      std::optional<MeshExactSource> exact;
+      if (job.exactCheck && distance != nullptr) {
+        exact.emplace(*distance, job.objectFromHand);
+        scene.exact = &*exact;
+      }
+      done.status = job.solver->solver->solve(scene, done.result);
+    }
+  } catch (const std::bad_alloc&) {
+    done.status = Status::out_of_memory;
+  } catch (...) {
+    done.status = Status::internal;
+  }
+  done.duration = std::chrono::duration_cast<std::chrono::microseconds>(
+      std::chrono::steady_clock::now() - start);
+  job = Job{};  // the solver reference and any field go before the lock
+
+  lock.lock();
+  ++jobsDone_;
+  if (target != nullptr && positions) {
+    target->appliedVersion = version;
+    if (refitBounds) target->bounds = *refitBounds;
+  }
+  s.running = false;
+  if (done.ticket >= s.cancelledBelow) s.done = std::move(done);
+}
+
+}  // namespace sdfg

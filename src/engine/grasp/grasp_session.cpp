@@ -203,6 +203,25 @@ Status GraspSession::updateTargetVertices(uint64_t id, std::span<const glm::vec3
   return Status::ok;
 }
 
+Status GraspSession::updateTargetVertices(uint64_t id, std::vector<glm::vec3>&& positions,
+                                          const Aabb& bounds) {
+  if (worker_ == nullptr) return updateTargetVertices(id, std::span<const glm::vec3>(positions));
+  auto it = targets_.find(id);
+  if (it == targets_.end() || !it->second.meshTarget) return Status::invalid_argument;
+  Target& t = it->second;
+  if (positions.size() != t.vertexCount) return Status::invalid_argument;
+  if (t.deviceCopy != nullptr)
+    std::copy(positions.begin(), positions.end(), t.deviceCopy->positions.begin());
+  t.bounds = bounds;
+  ++t.version;
+  worker_->updateVertices(id, std::move(positions), t.version);
+  return Status::ok;
+}
+
+std::vector<glm::vec3> GraspSession::vertexBuffer(uint64_t id) {
+  return worker_ != nullptr ? worker_->spareBuffer(id) : std::vector<glm::vec3>{};
+}
+
 bool GraspSession::removeTarget(uint64_t id) {
   for (size_t h = 0; h < 2; ++h) {
     if (hands_[h].grasp.holding && hands_[h].grasp.target == id) {

@@ -141,6 +141,12 @@ class GraspSession {
   Status updateTargetBounds(uint64_t id, const Aabb& bounds);
   // New positions, same count; a hand holding the target re-solves at its next update.
   Status updateTargetVertices(uint64_t id, std::span<const glm::vec3> positions);
+  // The same, handing over `positions` and their bounds (computed by the caller while it filled
+  // them): with a worker nothing is copied. Fill a buffer from vertexBuffer() to allocate nothing.
+  Status updateTargetVertices(uint64_t id, std::vector<glm::vec3>&& positions, const Aabb& bounds);
+  // A buffer the worker is done with, sized for target `id`'s positions when it has one (empty
+  // without a worker or before the first update).
+  std::vector<glm::vec3> vertexBuffer(uint64_t id);
   // Removes the target; a hand holding it lets go. Returns false for an unknown id.
   bool removeTarget(uint64_t id);
   bool hasTarget(uint64_t id) const { return targets_.count(id) != 0; }

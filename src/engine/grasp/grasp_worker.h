@@ -109,6 +109,9 @@ class GraspWorker {
   // New positions (same count as the mesh) of vertex version `version`; applied before the next
   // build of the target. Unknown ids are ignored.
   void updateVertices(uint64_t id, std::vector<glm::vec3> positions, uint64_t version);
+  // A buffer for the next updateVertices() of `id`: one the worker is done with, of the mesh's
+  // size when it has one (so filling it allocates nothing and touches no new pages), else empty.
+  std::vector<glm::vec3> spareBuffer(uint64_t id);
   void removeTarget(uint64_t id);
   TargetInfo targetInfo(uint64_t id) const;
 
@@ -117,7 +120,8 @@ class GraspWorker {
   // Drops the slot's queued job and any finished result; a running one's result is dropped when
   // it ends.
   void cancel(size_t slot);
-  // The slot's newest finished result, or nothing; never waits.
+  // The slot's newest finished result, or nothing; never waits (nothing either when the lock is
+  // busy at that instant: poll again).
   std::optional<Done> take(size_t slot);
 
   // Waits until nothing is queued or running, at most `timeout`; false on timeout. For tests and
@@ -132,6 +136,10 @@ class GraspWorker {
     std::shared_ptr<MeshDistance> distance;           // touched by the worker thread only
     std::optional<TriangleMesh> setupMesh;            // waiting for its set-up
     std::optional<std::vector<glm::vec3>> positions;  // waiting for the next build
+    // Used positions buffers, handed out again (spareBuffer). Three circulate for a mesh that
+    // deforms every frame (the app fills one, one waits, the worker applies one), so after the
+    // first updates nothing is allocated on the app's thread.
+    std::vector<std::vector<glm::vec3>> spares;
     uint64_t positionsVersion = 0;
     uint64_t appliedVersion = 0;
     TargetSetup setup = TargetSetup::pending;

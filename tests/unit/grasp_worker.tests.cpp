@@ -9,6 +9,8 @@
 #include <new>
 #include <thread>
 
+#include <glm/gtc/quaternion.hpp>
+
 #include "grasp/grasp_session.h"
 #include "grasp/grasp_worker.h"
 #include "io/shapes.h"
@@ -296,4 +298,64 @@ TEST_CASE("A mesh the worker cannot set up is reported once and never grabbed",
   CHECK(info.setup == TargetSetup::failed);
   CHECK_FALSE(info.error.empty());
   CHECK(worker.setupsDone() == 1);
+}
+
+TEST_CASE("A rigid motion of a held target re-solves on the field already built",
+          "[grasp_worker][core]") {
+  const TriangleMesh sphere = makeSphere(0.04f, 3);
+  GraspSession session(makeCpuSdfBackend(1), nullptr, GraspThreading::worker);
+  REQUIRE(session.configure(oursSettings()) == Status::ok);
+  REQUIRE(session.addTarget(7, sphere) == Status::ok);
+  REQUIRE(session.waitWorkerIdle(20s));
+  TargetFrame target{7, true, Pose{}};
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.grasp(Hand::right).solves > 0; }));
+  REQUIRE(session.buildStats().cpuBuilds == 1);
+
+  // The target starts moving in the hand: its next field is built in a grown box...
+  target.worldFromObject.position = glm::vec3(0.002f, 0.0f, 0.0f);
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.grasp(Hand::right).solves >= 2; }));
+  CHECK(session.buildStats().cpuBuilds == 2);
+  // ...which the next rigid motion (3 mm more and 2 degrees) solves on without a build.
+  target.worldFromObject.position = glm::vec3(0.005f, 0.0f, 0.0f);
+  target.worldFromObject.orientation = glm::angleAxis(glm::radians(2.0f), glm::vec3(0, 1, 0));
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.grasp(Hand::right).solves >= 3; }));
+  CHECK(session.buildStats().cpuBuilds == 2);
+  CHECK(session.buildStats().reusedFields == 1);
+  const GraspResult reused = session.grasp(Hand::right).result;
+
+  // The same placement solved on a field built for it: the same contacts, within what the exact
+  // check guarantees (its stops are on the mesh itself, 0.1 mm).
+  GraspSession fresh(makeCpuSdfBackend(1));
+  REQUIRE(fresh.configure(oursSettings()) == Status::ok);
+  REQUIRE(fresh.addTarget(7, sphere) == Status::ok);
+  REQUIRE(fresh.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+  const GraspResult& expected = fresh.grasp(Hand::right).result;
+  REQUIRE(fresh.grasp(Hand::right).solves == 1);
+  for (int f = 0; f < kFingerCount; ++f) {
+    CAPTURE(f);
+    CHECK(reused.fingers[f].contact == expected.fingers[f].contact);
+    if (!expected.fingers[f].contact) continue;
+    CHECK(glm::length(reused.fingers[f].contactPoint - expected.fingers[f].contactPoint) < 0.0005f);
+  }
+
+  // 15 cm away the field built does not hold the box: a new build.
+  target.worldFromObject = Pose{};
+  target.worldFromObject.position = glm::vec3(0.0f, 0.0f, 0.15f);
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.buildStats().cpuBuilds == 3; }));
+  CHECK(session.buildStats().reusedFields == 1);
+
+  // New vertices are a new object: a new build.
+  std::vector<glm::vec3> smaller = sphere.positions;
+  for (glm::vec3& p : smaller) p *= 0.9f;
+  target.worldFromObject = Pose{};
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.buildStats().cpuBuilds >= 4; }));
+  const uint64_t builds = session.buildStats().cpuBuilds;
+  REQUIRE(session.updateTargetVertices(7, smaller) == Status::ok);
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.buildStats().cpuBuilds > builds; }));
 }

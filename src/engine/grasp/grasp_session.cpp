@@ -310,6 +310,7 @@ Status GraspSession::collectJob(HandState& hand, size_t slot) {
   if (done->ticket != hand.ticket) return Status::ok;  // of a cancelled job
   hand.jobPending = false;
   if (done->built) ++stats_.cpuBuilds;
+  if (done->reused) ++stats_.reusedFields;
   if (hand.jobOnGpu) ++stats_.gpuBuilds;
   if (!hand.grasp.holding) return Status::ok;
   if (done->status != Status::ok) {

@@ -91,9 +91,10 @@ struct HandGrasp {
 
 // Where the session's grab-box SDFs were built so far.
 struct SdfBuildStats {
-  uint64_t gpuBuilds = 0;  // results collected from the deferred backend
-  uint64_t cpuBuilds = 0;  // builds on the CPU backend
-  bool gpuFailed = false;  // the deferred backend failed; the CPU builds from then on
+  uint64_t gpuBuilds = 0;     // results collected from the deferred backend
+  uint64_t cpuBuilds = 0;     // builds on the CPU backend
+  uint64_t reusedFields = 0;  // solves on an earlier CPU field moved rigidly (no build; worker)
+  bool gpuFailed = false;     // the deferred backend failed; the CPU builds from then on
 };
 
 // Where the CPU builds and the solves run (see the top of this file).

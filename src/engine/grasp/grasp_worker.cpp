@@ -1,5 +1,7 @@
 #include "grasp/grasp_worker.h"
 
+#include <algorithm>
+#include <limits>
 #include <new>
 
 #ifdef __linux__
@@ -8,6 +10,23 @@
 #endif
 
 namespace sdfg {
+namespace {
+
+// The box a field is built in when the target already moved in the hand: the same box grown by
+// kFieldMargin spacings on every side (same spacing, more nodes), so the next rigid motions of up
+// to that margin still find every node of the job's own box inside it (reuseMap).
+constexpr int kFieldMargin = 2;
+
+GridBox grownBox(const GridBox& box) {
+  GridBox grown = box;
+  const glm::vec3 spacing = box.spacing();
+  grown.resolution = box.resolution + glm::uvec3(2 * kFieldMargin);
+  if (glm::any(glm::greaterThan(grown.resolution, glm::uvec3(kMaxGridResolution)))) return box;
+  grown.size = box.size + spacing * float(2 * kFieldMargin);
+  return grown;
+}
+
+}  // namespace
 
 GraspWorker::GraspWorker(std::unique_ptr<SdfBackend> backend) : backend_(std::move(backend)) {
   thread_ = std::thread([this] { run(); });
@@ -112,6 +131,32 @@ uint64_t GraspWorker::setupsDone() const {
 uint64_t GraspWorker::jobsDone() const {
   std::lock_guard lock(mutex_);
   return jobsDone_;
+}
+
+std::optional<Pose> GraspWorker::reuseMap(const BuiltField& built, const Job& job,
+                                          uint64_t version) {
+  if (!built.valid || built.target != job.target || built.version != version) return std::nullopt;
+  if (!job.solver->reusesFields || built.jobBox.resolution != job.box.resolution ||
+      built.jobBox.size != job.box.size ||
+      built.jobBox.handFromBox.position != job.box.handFromBox.position ||
+      built.jobBox.handFromBox.orientation != job.box.handFromBox.orientation)
+    return std::nullopt;
+  // field hand <- object <- job hand: the same surface, seen from where the field was built.
+  const Pose fieldFromHand = built.objectFromHand.inverse() * job.objectFromHand;
+  // Every node of the job's own box must lie inside the built one, so everything a fresh field
+  // would tell the solver, this one tells too (beyond the job's box it tells more: the solver
+  // reads real values there instead of the border's). Its corners are the extreme points.
+  const GridBox& box = built.grid.box();
+  const Pose builtFromJobBox = box.handFromBox.inverse() * fieldFromHand * job.box.handFromBox;
+  const glm::vec3 half = job.box.size * 0.5f;
+  const glm::vec3 limit = box.size * 0.5f + glm::vec3(1e-6f);
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec3 corner((c & 1) ? half.x : -half.x, (c & 2) ? half.y : -half.y,
+                           (c & 4) ? half.z : -half.z);
+    const glm::vec3 p = builtFromJobBox.transformPoint(corner);
+    if (glm::any(glm::greaterThan(glm::abs(p), limit))) return std::nullopt;
+  }
+  return fieldFromHand;
 }
 
 void GraspWorker::run() {
@@ -229,13 +274,32 @@ void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job jo
       if (done.status == Status::ok) refitBounds = computeBounds(*positions);
     }
     const SdfGrid* field = job.field ? &*job.field : nullptr;
+    BuiltField& built = fields_[slot];
+    Pose fieldFromHand{};
     if (done.status == Status::ok && field == nullptr) {
       if (distance == nullptr) {
         done.status = Status::invalid_argument;  // removed, or not set up
+      } else if (const auto map = reuseMap(built, job, version)) {
+        fieldFromHand = *map;
+        field = &built.grid;
+        done.reused = true;
       } else {
-        done.status = backend_->build(*distance, job.objectFromHand, job.box, grid_);
+        // A re-solve of the same target and vertices means it moves in the hand: build a grown
+        // box, which the next motions reuse. A first grab builds the plain box (the fastest).
+        const bool moving = job.solver->reusesFields && built.valid && built.target == job.target &&
+                            built.version == version;
+        built.valid = false;
+        built.jobBox = job.box;
+        done.status = backend_->build(*distance, job.objectFromHand,
+                                      moving ? grownBox(job.box) : job.box, built.grid);
         done.built = done.status == Status::ok;
-        field = &grid_;
+        if (done.built) {
+          built.valid = true;
+          built.target = job.target;
+          built.version = version;
+          built.objectFromHand = job.objectFromHand;
+        }
+        field = &built.grid;
       }
     }
     if (done.status == Status::ok && job.solver == nullptr) done.status = Status::internal;
@@ -243,12 +307,14 @@ void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job jo
       SolverSetup& setup = *job.solver;
       setup.prepareStatus = setup.solver->prepare(setup.model, setup.box, setup.options);
       setup.prepared = true;
+      setup.reusesFields = setup.solver->name() == "ours" && !setup.options.approach;
     }
     if (done.status == Status::ok) done.status = job.solver->prepareStatus;
     if (done.status == Status::ok) {
       GraspScene scene;
       scene.field = field;
       scene.objectFromHand = job.objectFromHand;
+      scene.fieldFromHand = fieldFromHand;
       std::optional<MeshExactSource> exact;
       if (job.exactCheck && distance != nullptr) {
         exact.emplace(*distance, job.objectFromHand);

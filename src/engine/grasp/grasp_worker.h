@@ -73,6 +73,9 @@ class GraspWorker {
     SolverOptions options;
     bool prepared = false;  // worker thread only
     Status prepareStatus = Status::ok;
+    // Worker thread only: whether the solver can solve on a field built at another relative
+    // pose (GraspScene::fieldFromHand; "ours" without the approach).
+    bool reusesFields = false;
   };
 
   // One hand's build and solve.
@@ -94,6 +97,7 @@ class GraspWorker {
     Pose objectFromHand;
     uint64_t version = 0;  // the target's vertex version the result was solved on
     bool built = false;    // a grab-box SDF was built on the CPU for it
+    bool reused = false;   // solved on the slot's last field, moved rigidly (nothing built)
     std::chrono::microseconds duration{0};
   };
 
@@ -158,8 +162,25 @@ class GraspWorker {
   void runSetup(std::unique_lock<std::mutex>& lock, uint64_t id, std::shared_ptr<Target> target);
   void runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job job);
 
+  // The field a slot built last, for what it was built (worker thread only). A later job of the
+  // same target and vertices whose whole box, moved rigidly to the new relative pose, still lies
+  // inside it solves on it (GraspScene::fieldFromHand) instead of building: a rigid motion does
+  // not change the object, only where the box sits on it. Once a target moves in the hand, its
+  // fields are built in a grown box (two spacings more on every side) so that the next motions
+  // fit.
+  struct BuiltField {
+    SdfGrid grid;
+    bool valid = false;
+    uint64_t target = 0;
+    uint64_t version = 0;
+    Pose objectFromHand;
+    GridBox jobBox;  // the box the job asked for (the grid's may be grown)
+  };
+  // The map from the job's hand frame into the field's, when the field covers the job.
+  static std::optional<Pose> reuseMap(const BuiltField& built, const Job& job, uint64_t version);
+
   std::unique_ptr<SdfBackend> backend_;  // worker thread only
-  SdfGrid grid_;                         // worker thread only: the last built field
+  std::array<BuiltField, kSlots> fields_;
 
   mutable std::mutex mutex_;  // guards everything below
   mutable std::condition_variable wake_;

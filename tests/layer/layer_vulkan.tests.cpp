@@ -48,11 +48,12 @@ State graspState(const App& app, const Ext& ext) {
 }
 
 // Runs frames until the hand shows a grasp (the GPU result arrives a frame or more after the
-// request), at most `maxFrames`. The sleep lets lavapipe's worker run; it is the test's, not the
-// layer's (the layer never waits in the frame path).
-State runUntilGrasping(App& app, const Ext& ext, int maxFrames = 400) {
+// request, then the session's worker solves it), at most 60 s. The sleep lets lavapipe and the
+// worker run; it is the test's, not the layer's (the layer never waits in the frame path).
+State runUntilGrasping(App& app, const Ext& ext) {
   State s = graspState(app, ext);
-  for (int i = 0; i < maxFrames && !s.state.isGrasping; ++i) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!s.state.isGrasping && std::chrono::steady_clock::now() < deadline) {
     app.frame();
     s = graspState(app, ext);
     if (!s.state.isGrasping) std::this_thread::sleep_for(std::chrono::milliseconds(1));
@@ -311,7 +312,7 @@ TEST_CASE("A device loss on the GPU path falls back to the CPU and the hand stil
       Ext ext(app);
       XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
       makeTarget(app, ext, makeIcosphere(radius, 4), {{0, 0, 0, 1}, centre});
-      State s = runUntilGrasping(app, ext, 50);
+      State s = runUntilGrasping(app, ext);
       REQUIRE(s.state.isGrasping);
       CHECK(s.build.gpuFailed);
       CHECK(s.build.graspBackend == XR_GRASP_SDF_BACKEND_CPU_SDFG);

@@ -135,6 +135,7 @@ struct RunResult {
   double createMs = 0;  // the xrCreateGraspTargetSDFG call
   double setupMs = 0;   // from create until the target is ready
   double maxUpdateCallMs = 0;
+  std::array<uint64_t, kPhaseCount> builds{};  // CPU grab-box builds during each phase
 };
 
 class App {
@@ -291,11 +292,13 @@ class App {
         timed("xrLocateHandJointsEXT", [&] { locate_(trackers_[h], &info, &locations); });
       }
       XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
-      XrGraspTargetsSetupInfoSDFG setup{XR_TYPE_GRASP_TARGETS_SETUP_INFO_SDFG};
+      XrGraspBuildInfoSDFG build{XR_TYPE_GRASP_BUILD_INFO_SDFG};
+      XrGraspTargetsSetupInfoSDFG setup{XR_TYPE_GRASP_TARGETS_SETUP_INFO_SDFG, &build};
       XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG, &setup};
       timed("xrGetGraspStateSDFG", [&] { state_(session_, &gi, &st); });
       grasping_ = st.isGrasping == XR_TRUE;
       ready_ = setup.readyCount > 0;
+      cpuBuilds_ = build.cpuBuildCount;
     }
     XrFrameEndInfo ei{XR_TYPE_FRAME_END_INFO};
     ei.displayTime = fs.predictedDisplayTime;
@@ -325,6 +328,7 @@ class App {
 
   bool grasping() const { return grasping_; }
   bool ready() const { return ready_; }
+  uint64_t cpuBuilds() const { return cpuBuilds_; }
   uint64_t framesEnded() const { return framesEnded_; }
   bool layer() const { return layer_; }
 
@@ -366,6 +370,7 @@ class App {
   uint64_t framesEnded_ = 0;
   bool grasping_ = false;
   bool ready_ = false;
+  uint64_t cpuBuilds_ = 0;  // the session's CPU builds so far (XrGraspBuildInfoSDFG)
   XrGraspTargetSDFG target_ = XR_NULL_HANDLE;
   std::array<XrHandTrackerEXT, 2> trackers_{};
   std::array<XrHandJointLocationEXT, XR_HAND_JOINT_COUNT_EXT> joints_{};
@@ -432,7 +437,13 @@ RunResult run(const Object& object, bool layer, int phaseFrames) {
     app.frame(ignored, none);
   }
   // Open hand.
+  uint64_t buildsBefore = app.cpuBuilds();
+  auto endPhase = [&](int phase) {
+    out.builds[phase] = app.cpuBuilds() - buildsBefore;
+    buildsBefore = app.cpuBuilds();
+  };
   for (int i = 0; i < phaseFrames; ++i) out.frameMs[0].push_back(app.frame(out.callMs, none));
+  endPhase(0);
   // Grab: the squeeze crosses the threshold at frame S (read by that frame's xrSyncActions).
   const uint64_t s = app.framesEnded();
   app.script(gripLine(0, grip) + squeezeLine(0, 0.0f) + squeezeLine(s > 0 ? s - 1 : 0, 0.0f) +
@@ -450,8 +461,10 @@ RunResult run(const Object& object, bool layer, int phaseFrames) {
     out.error = "no grasp within " + std::to_string(maxGrab) + " frames";
     return out;
   }
+  endPhase(1);
   // Held still.
   for (int i = 0; i < phaseFrames; ++i) out.frameMs[2].push_back(app.frame(out.callMs, none));
+  endPhase(2);
   // Held, moving: 30 degrees over 60 frames (scaled with --frames), about its vertical axis.
   const float turn = glm::radians(30.0f);
   for (int i = 1; i <= phaseFrames; ++i) {
@@ -463,6 +476,7 @@ RunResult run(const Object& object, bool layer, int phaseFrames) {
       return d;
     }));
   }
+  endPhase(3);
   // Held, deforming: every vertex rescaled about the centre each frame (down to 94 %).
   std::vector<XrVector3f> scaled = object.vertices;
   for (int i = 1; i <= phaseFrames; ++i) {
@@ -477,6 +491,7 @@ RunResult run(const Object& object, bool layer, int phaseFrames) {
       return d;
     }));
   }
+  endPhase(4);
   out.ok = true;
   return out;
 }
@@ -522,8 +537,8 @@ void writeJson(const std::string& path, const std::vector<MeshResult>& results, 
         << ", \"added_p50_ms\": " << fmt(a.p50) << ", \"added_p99_ms\": " << fmt(a.p99)
         << ", \"added_max_ms\": " << fmt(a.max) << ", \"off_median_ms\": " << fmt(r.offMedian[p])
         << ", \"off_p99_ms\": " << fmt(r.offStats[p].p99)
-        << ", \"off_max_ms\": " << fmt(r.offStats[p].max) << "}" << (p + 1 < kPhaseCount ? "," : "")
-        << "\n";
+        << ", \"off_max_ms\": " << fmt(r.offStats[p].max) << ", \"cpu_builds\": " << r.on.builds[p]
+        << "}" << (p + 1 < kPhaseCount ? "," : "") << "\n";
     }
     f << "      },\n      \"calls_on\": {";
     bool first = true;

@@ -2,6 +2,7 @@
 // one call into the core, one conversion of the result. A failing call changes nothing.
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 #include "intercepts.h"
@@ -84,6 +85,40 @@ XrResult verifyVertices(const char* cmd, const XrGraspTargetVerticesSDFG* v, boo
     SDFG_VERIFY(cmd, std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z),
                 XR_ERROR_VALIDATION_FAILURE, "(vertices[%u]) is not finite", i);
   }
+  return XR_SUCCESS;
+}
+
+// The update's checks (verifyVertices with update = true) fused with the copy into `out` and its
+// bounds, in one pass over the app's array. On failure nothing but `out`'s contents changed.
+XrResult copyVertices(const char* cmd, const XrGraspTargetVerticesSDFG* v,
+                      uint32_t expectedVertexCount, std::vector<glm::vec3>& out, Aabb& bounds) {
+  SDFG_VERIFY(cmd, v->vertexCount >= 3 && v->vertexCount <= XR_MAX_GRASP_TARGET_VERTICES_SDFG,
+              XR_ERROR_VALIDATION_FAILURE, "(vertexCount) is %u, must be in 3..%u", v->vertexCount,
+              XR_MAX_GRASP_TARGET_VERTICES_SDFG);
+  SDFG_VERIFY_NOT_NULL(cmd, v->vertices);
+  SDFG_VERIFY(cmd, v->vertexCount == expectedVertexCount, XR_ERROR_VALIDATION_FAILURE,
+              "(vertexCount) is %u, the target has %u", v->vertexCount, expectedVertexCount);
+  SDFG_VERIFY(cmd, v->indexCount == 0 && v->indices == nullptr, XR_ERROR_VALIDATION_FAILURE,
+              "(indexCount) and (indices) must be 0 and NULL on update: the topology is fixed");
+  out.resize(v->vertexCount);
+  // No branch in the loop: x - x is 0 for a finite x and NaN otherwise, so `check` turns NaN at
+  // the first NaN or infinity; the culprit is looked for only then.
+  glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo), check(0.0f);
+  for (uint32_t i = 0; i < v->vertexCount; ++i) {
+    const glm::vec3 p(v->vertices[i].x, v->vertices[i].y, v->vertices[i].z);
+    check += p - p;
+    out[i] = p;
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  if (!(check.x == 0.0f && check.y == 0.0f && check.z == 0.0f)) {
+    for (uint32_t i = 0; i < v->vertexCount; ++i) {
+      const XrVector3f& p = v->vertices[i];
+      SDFG_VERIFY(cmd, std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z),
+                  XR_ERROR_VALIDATION_FAILURE, "(vertices[%u]) is not finite", i);
+    }
+  }
+  bounds = Aabb{lo, hi};
   return XR_SUCCESS;
 }
 
@@ -253,7 +288,9 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
   t->pose = createInfo->placement.pose;
   t->vertexCount = arrays->vertexCount;
   t->indexCount = arrays->indexCount;
-  if (Status st = s->grasp->addTarget(t->handle, *mesh); st != Status::ok)
+  // Kept for the updates' synchronous check: the worker owns the mesh from here on.
+  t->indices = std::make_shared<const std::vector<uint32_t>>(mesh->indices);
+  if (Status st = s->grasp->addTarget(t->handle, std::move(*mesh)); st != Status::ok)
     return logError(toXrResult(st), cmd, "the target could not be built (%s)", toString(st));
   applyTargetSettings(*s, t->handle, settings);
   s->targets[t->handle] = t;
@@ -325,11 +362,23 @@ XrResult XRAPI_CALL SdfgXrUpdateGraspTargetVerticesSDFG(XrGraspTargetSDFG target
   SDFG_VERIFY(cmd, !t->deviceBuffers, XR_ERROR_VALIDATION_FAILURE,
               "(vertices) are arrays; the target was created from Vulkan buffers");
   const auto* v = static_cast<const XrGraspTargetVerticesSDFG*>(vertices);
-  if (XrResult r = verifyVertices(cmd, v, true, t->vertexCount); r != XR_SUCCESS) return r;
-  const std::vector<glm::vec3> positions = toPositions(*v);
+  Aabb bounds;
   std::lock_guard lock(s->mutex);
   SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
-  if (Status st = s->grasp->updateTargetVertices(t->handle, positions); st != Status::ok)
+  // One pass over the app's array: check, copy into a buffer the session's worker is done with
+  // (no allocation, no fresh pages) and bound. A deforming mesh pays this every frame on the
+  // app's thread; everything else (the refit) is the worker's.
+  std::vector<glm::vec3> positions = s->grasp->vertexBuffer(t->handle);
+  if (XrResult r = copyVertices(cmd, v, t->vertexCount, positions, bounds); r != XR_SUCCESS)
+    return r;
+  // New positions that collapse a triangle are refused here, at once, as on create: the refit
+  // on the worker could only drop them without a word to the app.
+  if (t->indices != nullptr) {
+    if (auto e = findDegenerateTriangle(positions, *t->indices))
+      return logError(XR_ERROR_VALIDATION_FAILURE, cmd, "(vertices) %s", e->message.c_str());
+  }
+  if (Status st = s->grasp->updateTargetVertices(t->handle, std::move(positions), bounds);
+      st != Status::ok)
     return logError(toXrResult(st), cmd, "the vertices were refused (%s)", toString(st));
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)
@@ -397,6 +446,16 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
     info->cpuBuildCount = st.cpuBuilds;
     info->gpuFailed = st.gpuFailed ? XR_TRUE : XR_FALSE;
     info->pendingGpuBuilds = uint32_t(s->grasp->pendingBuilds());
+  }
+  if (auto* setup = findInChain<XrGraspTargetsSetupInfoSDFG>(
+          state->next, XR_TYPE_GRASP_TARGETS_SETUP_INFO_SDFG)) {
+    setup->readyCount = setup->pendingCount = setup->failedCount = 0;
+    for (const auto& [id, target] : s->targets) {
+      const TargetSetup st = s->grasp->targetSetup(id);
+      if (st == TargetSetup::ready) ++setup->readyCount;
+      if (st == TargetSetup::pending) ++setup->pendingCount;
+      if (st == TargetSetup::failed) ++setup->failedCount;
+    }
   }
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)

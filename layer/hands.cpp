@@ -145,6 +145,10 @@ void updateGrasps(SessionState& s) {
       SDFG_LOG_WARN(cmd, "grasp solve failed (%s); the hand stays open", toString(st));
     noteGraspChange(s, hand, wasGrasping, wasTarget);
   }
+  // Set-ups run on the session's worker: one line per target whose mesh it could not take.
+  for (const auto& [id, why] : s.grasp->takeSetupFailures())
+    SDFG_LOG_WARN(cmd, "grasp target 0x%llx cannot be grasped: its set-up failed (%s)",
+                  static_cast<unsigned long long>(id), why.c_str());
 }
 
 XrResult XRAPI_CALL SdfgXrCreateHandTrackerEXT(XrSession session,
@@ -268,10 +272,18 @@ XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT tracker,
       if (!grasp.holding || grasp.solves == 0) return r;  // pass-through: untouched
       JointPoses joints;
       for (int j = 0; j < kJointCount; ++j) joints[j] = toPose(locations->jointLocations[j].pose);
-      const Pose baseFromWrist = joints[size_t(Joint::wrist)];
-      const Pose wristFromBase = baseFromWrist.inverse();
+      const Pose wristFromBase = joints[size_t(Joint::wrist)].inverse();
       JointPoses local;
       for (int j = 0; j < kJointCount; ++j) local[j] = wristFromBase * joints[j];
+      Pose baseFromWrist = joints[size_t(Joint::wrist)];
+      if (const auto c = s->grasp->reposeCorrection(t->hand)) {
+        // A re-solve is on its way: the whole hand follows the target since the shown solve.
+        baseFromWrist = baseFromWrist * *c;
+        for (int j = 0; j < kJointCount; ++j) {
+          joints[j] = baseFromWrist * local[j];
+          locations->jointLocations[j].pose = toXr(joints[j]);
+        }
+      }
       const HandModel& model = s->grasp->model(t->hand);
       FingerJointCurls curls;
       std::array<bool, kFingerCount> replace;
@@ -349,7 +361,10 @@ XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT tracker,
     return XR_SUCCESS;
   }
   const HandModel& model = s->grasp->model(t->hand);
-  const Pose baseFromWrist = *grip * wristFromGrip(model).inverse();
+  Pose baseFromWrist = *grip * wristFromGrip(model).inverse();
+  // A re-solve is on its way: the hand follows the target since the shown solve, so its contacts
+  // stay on the surface (docs/threading.md).
+  if (const auto c = s->grasp->reposeCorrection(t->hand)) baseFromWrist = baseFromWrist * *c;
   const FingerCurls user = curlsFromSqueeze(s->squeeze[h], range);
   JointPoses joints;
   JointRadii radii;

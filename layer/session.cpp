@@ -117,7 +117,10 @@ XrResult XRAPI_CALL SdfgXrCreateSession(XrInstance instance, const XrSessionCrea
   const glm::vec3 spacing = s->settings.box.spacing();
   cpuOptions.exactBand =
       state->config.sdfFarBand * std::max(spacing.x, std::max(spacing.y, spacing.z));
-  s->grasp = std::make_unique<GraspSession>(makeCpuSdfBackend(2, cpuOptions), std::move(gpu));
+  // CPU builds, target set-ups and solves run on the session's worker thread, never inside the
+  // app's calls; its builder uses that one thread (an app on a 2-core machine keeps the other).
+  s->grasp = std::make_unique<GraspSession>(makeCpuSdfBackend(1, cpuOptions), std::move(gpu),
+                                            GraspThreading::worker);
   s->grasp->setDeferredForMeshTargets(s->gpuForArrayTargets);
   if (Status st = s->grasp->configure(s->settings); st != Status::ok) {
     SDFG_LOG_WARN(cmd, "configured solver '%s' is not usable (%s); using 'paper'",

@@ -54,6 +54,7 @@ XR_DEFINE_HANDLE(XrGraspTargetSDFG)
 #define XR_TYPE_GRASP_OPTIONS_SDFG ((XrStructureType)1009900005)
 #define XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG ((XrStructureType)1009900006)
 #define XR_TYPE_GRASP_BUILD_INFO_SDFG ((XrStructureType)1009900007)
+#define XR_TYPE_GRASP_TARGETS_SETUP_INFO_SDFG ((XrStructureType)1009900008)
 #define XR_OBJECT_TYPE_GRASP_TARGET_SDFG ((XrObjectType)1009900000)
 
 // Limits, so a stray count cannot exhaust memory.
@@ -184,6 +185,20 @@ typedef struct XrGraspBuildInfoSDFG {
   XrBool32 gpuFailed;  // the GPU path failed (device lost or any Vulkan error): CPU from then on
   uint32_t pendingGpuBuilds;  // GPU builds requested and not yet collected (0..2)
 } XrGraspBuildInfoSDFG;
+
+// Optional output, chained on XrGraspStateSDFG::next: the set-up of the session's targets.
+// xrCreateGraspTargetSDFG with CPU arrays checks and copies the mesh and returns; the exact
+// distance structure (BVH, pseudo-normals) is built on the layer's worker thread, and the target
+// can be grasped only once it is ready (a squeeze before that grabs nothing). A set-up that
+// fails (the mesh was refused, or memory ran out) is logged once and leaves the target never
+// graspable. Vulkan buffer targets are ready at once.
+typedef struct XrGraspTargetsSetupInfoSDFG {
+  XrStructureType type;  // XR_TYPE_GRASP_TARGETS_SETUP_INFO_SDFG
+  void* XR_MAY_ALIAS next;
+  uint32_t readyCount;    // targets of the session that can be grasped
+  uint32_t pendingCount;  // targets whose set-up is queued or running
+  uint32_t failedCount;   // targets whose set-up failed
+} XrGraspTargetsSetupInfoSDFG;
 
 // Solver strategies; the layer's configuration picks the default.
 typedef enum XrGraspSolverSDFG {

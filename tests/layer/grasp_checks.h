@@ -5,10 +5,12 @@
 
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <limits>
 #include <string>
+#include <thread>
 
 #include "test_scenes.h"
 #include "xr_harness.h"
@@ -57,6 +59,23 @@ inline XrGraspTargetSDFG makeTarget(const App& app, const Ext& ext, const TestMe
   XrGraspTargetSDFG t = XR_NULL_HANDLE;
   REQUIRE(ext.create(app.session, &ci, &t) == XR_SUCCESS);
   return t;
+}
+
+// Runs frames until `hand`'s grasp state says `grasping` (the layer solves on its session's
+// worker, so a grasp shows some frames after the squeeze, depending on the machine), at most
+// `timeout`; returns whether it got there. The sleep is the test's, to give the worker the core.
+inline bool framesUntilGrasping(App& app, const Ext& ext, XrHandEXT hand, bool grasping = true,
+                                std::chrono::milliseconds timeout = std::chrono::seconds(60)) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    app.frame();
+    XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, hand};
+    XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG};
+    if (ext.state(app.session, &gi, &st) != XR_SUCCESS) return false;
+    if ((st.isGrasping == XR_TRUE) == grasping) return true;
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
 }
 
 inline float length(const XrVector3f& v) {

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <catch2/catch.hpp>
+
+#include <chrono>
 #include <memory>
 #include <string>
 
@@ -15,14 +17,12 @@
 
 namespace sdfg::test {
 
-// Runs frames until `done()` holds; false if it still does not after `bound` frames.
+// Runs frames until `done()` holds; false if it still does not after `limit` of wall time. A
+// time, not a frame count: the layer solves on its session's worker, so how many frames an
+// outcome takes depends on the machine.
 template <class F>
-bool runUntil(App& app, F done, int bound = 300) {
-  for (int i = 0; i < bound; ++i) {
-    if (done()) return true;
-    app.frame();
-  }
-  return done();
+bool runUntil(App& app, F done, std::chrono::milliseconds limit = std::chrono::seconds(60)) {
+  return app.framesUntil(done, limit);
 }
 
 // A controller-only runtime, one hand squeezing from frame `squeezeFrame` (and releasing at

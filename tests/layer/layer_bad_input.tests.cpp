@@ -477,7 +477,8 @@ TEST_CASE("Bad input of every class gets its documented error and changes nothin
       CHECK(again.hands[1].fingers[f].curl == reference.hands[1].fingers[f].curl);
       CHECK(again.hands[1].fingers[f].inContact == reference.hands[1].fingers[f].inContact);
     }
-    CHECK(again.build.cpuBuildCount == reference.build.cpuBuildCount + 1);
+    // (Not a build count: the session's worker may solve the new grab on the field it built for
+    // the first, the target and its vertices being unchanged.)
     return;  // the grasp was redone on purpose; the generic check below does not apply
   }
 

@@ -13,6 +13,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "grasp_checks.h"
+#include "mock_runtime_test.h"
 #include "test_scenes.h"
 #include "xr_harness.h"
 
@@ -40,7 +41,7 @@ GraspOutcome graspScene(const TestMesh& mesh, const XrPosef& objectPose, const X
     REQUIRE(setOptions(app.session, &o) == XR_SUCCESS);
   }
   makeTarget(app, ext, mesh, objectPose);
-  app.frames(12);
+  REQUIRE(framesUntilGrasping(app, ext, xrHand));
   REQUIRE(locateJoints(app, tracker, out.joints) == XR_SUCCESS);
   XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, xrHand};
   REQUIRE(ext.state(app.session, &gi, &out.state) == XR_SUCCESS);
@@ -239,7 +240,7 @@ TEST_CASE("Destroying a held target lets the hand go back to the user's pose", "
   XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
   const XrVector3f centre = boxCentreInLocal(grip, true);
   XrGraspTargetSDFG target = makeTarget(app, ext, makeIcosphere(0.04f, 3), {{0, 0, 0, 1}, centre});
-  app.frames(12);
+  REQUIRE(framesUntilGrasping(app, ext, XR_HAND_RIGHT_EXT));
   XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
   XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG};
   REQUIRE(ext.state(app.session, &gi, &st) == XR_SUCCESS);
@@ -277,7 +278,8 @@ TEST_CASE("Two hands grab two objects at once", "[layer][grasp]") {
   const XrVector3f cl = boxCentreInLocal(left, false), cr = boxCentreInLocal(right, true);
   XrGraspTargetSDFG tl = makeTarget(app, ext, makeIcosphere(0.035f, 3), {{0, 0, 0, 1}, cl});
   XrGraspTargetSDFG tr = makeTarget(app, ext, makeIcosphere(0.045f, 3), {{0, 0, 0, 1}, cr});
-  app.frames(12);
+  REQUIRE(framesUntilGrasping(app, ext, XR_HAND_LEFT_EXT));
+  REQUIRE(framesUntilGrasping(app, ext, XR_HAND_RIGHT_EXT));
   for (auto [hand, target] : {std::pair{XR_HAND_LEFT_EXT, tl}, std::pair{XR_HAND_RIGHT_EXT, tr}}) {
     XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, hand};
     XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG};
@@ -293,21 +295,22 @@ TEST_CASE("Releasing the squeeze ends the grasp", "[layer][grasp]") {
   env.handTracking = "absent";
   const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
   env.script = gripLine(0, "right", grip) + squeezeLine(0, "right", 0.0f) +
-               squeezeLine(4, "right", 0.0f) + squeezeLine(6, "right", 1.0f) +
-               squeezeLine(10, "right", 1.0f) + squeezeLine(11, "right", 0.0f);
+               squeezeLine(4, "right", 0.0f) + squeezeLine(6, "right", 1.0f);
   applyEnv(env);
   App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME}});
   REQUIRE(app.ok());
   Ext ext(app);
   makeTarget(app, ext, makeIcosphere(0.04f, 3), {{0, 0, 0, 1}, boxCentreInLocal(grip, true)});
-  XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
-  XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG};
-  app.frames(9);
-  REQUIRE(ext.state(app.session, &gi, &st) == XR_SUCCESS);
-  CHECK(st.isGrasping);
-  app.frames(5);
-  REQUIRE(ext.state(app.session, &gi, &st) == XR_SUCCESS);
-  CHECK_FALSE(st.isGrasping);
+  REQUIRE(framesUntilGrasping(app, ext, XR_HAND_RIGHT_EXT));
+  // The grasp is shown: now the user lets go (the timeline is frame-numbered, so the release is
+  // scripted from the frame reached).
+  auto setScript = app.fn<PFN_xrMockRuntimeSetScriptSDFG>("xrMockRuntimeSetScriptSDFG");
+  REQUIRE(setScript != nullptr);
+  const uint64_t now = app.framesEnded;
+  const std::string release = gripLine(0, "right", grip) + squeezeLine(now, "right", 1.0f) +
+                              squeezeLine(now + 1, "right", 0.0f);
+  REQUIRE(setScript(app.instance, release.c_str()) == XR_SUCCESS);
+  CHECK(framesUntilGrasping(app, ext, XR_HAND_RIGHT_EXT, false));
   CHECK(validationLog().empty());
 }
 
@@ -332,8 +335,10 @@ TEST_CASE("With runtime hand tracking, a grasp never moves a finger the user hol
       // The grab box of a tracked hand hangs below its wrist joint (hand space (0, -7.5, -8.1) cm).
       const XrVector3f c{grip.position.x, grip.position.y - 0.075f, grip.position.z - 0.081f};
       makeTarget(app, ext, makeIcosphere(0.04f, 3), {{0, 0, 0, 1}, c});
+      REQUIRE(framesUntilGrasping(app, ext, XR_HAND_RIGHT_EXT));
+    } else {
+      app.frames(12);  // no grasp to wait for: the runtime's open hand, the same every frame
     }
-    app.frames(12);
     Joints j;
     REQUIRE(locateJoints(app, tracker, j) == XR_SUCCESS);
     if (withTarget) {
@@ -367,7 +372,7 @@ TEST_CASE("Destroying the session while a hand holds a target releases everythin
   XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
   XrGraspTargetSDFG target =
       makeTarget(app, ext, makeIcosphere(0.04f, 3), {{0, 0, 0, 1}, boxCentreInLocal(grip, true)});
-  app.frames(10);
+  REQUIRE(framesUntilGrasping(app, ext, XR_HAND_RIGHT_EXT));
   XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
   XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG};
   REQUIRE(ext.state(app.session, &gi, &st) == XR_SUCCESS);

@@ -403,8 +403,8 @@ TEST_CASE("A grab before the GPU path is ready is built on the CPU at once", "[l
     CHECK_FALSE(s.build.gpuFailed);  // not a failure: the GPU is only not ready
     CHECK(s.build.gpuBuildCount == 0);
     CHECK(s.build.cpuBuildCount >= 1);
-    // Solved in the frame of the squeeze: the CPU build runs inside that xrSyncActions.
-    CHECK(app.framesEnded <= 5);
+    // The GPU path never becomes ready here (never_ready), so a grasp at all shows the grab did
+    // not wait for it: the CPU build ran on the session's worker instead.
     checkContacts(outcome(app, tracker, s),
                   [&](const XrVector3f& p) { return length(sub(p, centre)) - radius; });
   }

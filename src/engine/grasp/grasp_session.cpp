@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace sdfg {
 namespace {
@@ -36,11 +37,16 @@ std::optional<Error> GraspSettings::validate() const {
 }
 
 GraspSession::GraspSession(std::unique_ptr<SdfBackend> backend,
-                           std::unique_ptr<DeferredSdfBackend> deferred)
-    : backend_(std::move(backend)), deferred_(std::move(deferred)) {
+                           std::unique_ptr<DeferredSdfBackend> deferred, GraspThreading threading)
+    : deferred_(std::move(deferred)) {
   hands_[0].model = HandModel::defaultAdult(Hand::left);
   hands_[1].model = HandModel::defaultAdult(Hand::right);
   (void)configure(settings_);
+  // With a worker, the CPU builder is the worker's alone.
+  if (threading == GraspThreading::worker)
+    worker_ = std::make_unique<GraspWorker>(std::move(backend));
+  else
+    backend_ = std::move(backend);
 }
 
 GraspSession::~GraspSession() = default;
@@ -64,15 +70,71 @@ Status GraspSession::configure(const GraspSettings& settings) {
   return Status::ok;
 }
 
-Status GraspSession::addTarget(uint64_t id, const TriangleMesh& mesh) {
+Status GraspSession::addTarget(uint64_t id, TriangleMesh mesh) {
   if (targets_.count(id) != 0) return Status::invalid_argument;
+  Target t;
+  t.meshTarget = true;
+  if (worker_ != nullptr) {
+    // The set-up (seconds for a million triangles) is the worker's; the target is graspable
+    // once it is ready (refreshSetups).
+    if (deferredUsable() && deferredForMeshTargets_)
+      t.deviceCopy = std::make_unique<TriangleMesh>(mesh);
+    t.setup = TargetSetup::pending;
+    t.vertexCount = mesh.positions.size();
+    worker_->addTarget(id, std::move(mesh));
+    targets_.emplace(id, std::move(t));
+    return Status::ok;
+  }
   auto distance = MeshDistance::create(mesh);
   if (!distance) return distance.error().code;
-  Target t;
   t.bounds = computeBounds(mesh.positions);
   t.distance = std::move(*distance);
   targets_.emplace(id, std::move(t));
   return Status::ok;
+}
+
+TargetSetup GraspSession::targetSetup(uint64_t id) const {
+  auto it = targets_.find(id);
+  if (it == targets_.end()) return TargetSetup::unknown;
+  if (it->second.setup == TargetSetup::pending && worker_ != nullptr)
+    return worker_->targetInfo(id).setup;
+  return it->second.setup;
+}
+
+std::vector<std::pair<uint64_t, std::string>> GraspSession::takeSetupFailures() {
+  refreshSetups();
+  return std::exchange(setupFailures_, {});
+}
+
+bool GraspSession::waitWorkerIdle(std::chrono::milliseconds timeout) const {
+  return worker_ == nullptr || worker_->waitIdle(timeout);
+}
+
+void GraspSession::refreshSetups() {
+  if (worker_ == nullptr) return;
+  for (auto& [id, t] : targets_) {
+    if (t.setup != TargetSetup::pending) continue;
+    GraspWorker::TargetInfo info = worker_->targetInfo(id);
+    if (info.setup == TargetSetup::ready) {
+      // Bounds set by updateTargetVertices meanwhile are newer than the set-up's.
+      if (t.version == 0) t.bounds = info.bounds;
+      t.setup = TargetSetup::ready;
+    } else if (info.setup == TargetSetup::failed) {
+      t.setup = TargetSetup::failed;
+      setupFailures_.emplace_back(id, std::move(info.error));
+    }
+  }
+}
+
+std::optional<Pose> GraspSession::reposeCorrection(Hand side) const {
+  const HandState& hand = hands_[size_t(side)];
+  if (!hand.grasp.holding || hand.grasp.solves == 0 || !hand.objectFromHandNow) return std::nullopt;
+  const Pose& now = *hand.objectFromHandNow;
+  const Pose& solved = hand.grasp.objectFromHand;
+  if (glm::length(now.position - solved.position) <= settings_.moveTolerance &&
+      angleBetween(now.orientation, solved.orientation) <= settings_.turnTolerance)
+    return std::nullopt;
+  return now.inverse() * solved;
 }
 
 Status GraspSession::addDeviceTarget(uint64_t id, const Aabb& bounds) {
@@ -87,7 +149,7 @@ Status GraspSession::addDeviceTarget(uint64_t id, const Aabb& bounds) {
 
 Status GraspSession::updateTargetBounds(uint64_t id, const Aabb& bounds) {
   auto it = targets_.find(id);
-  if (it == targets_.end() || it->second.distance != nullptr) return Status::invalid_argument;
+  if (it == targets_.end() || it->second.meshTarget) return Status::invalid_argument;
   if (!validBounds(bounds)) return Status::invalid_argument;
   it->second.bounds = bounds;
   return Status::ok;
@@ -122,15 +184,49 @@ void GraspSession::dropDeferred() {
 void GraspSession::cancelPending(HandState& hand, size_t slot) {
   if (hand.pending && deferred_ != nullptr) deferred_->cancel(slot);
   hand.pending = false;
+  if (hand.jobPending && worker_ != nullptr) worker_->cancel(slot);
+  hand.jobPending = false;
 }
 
 Status GraspSession::updateTargetVertices(uint64_t id, std::span<const glm::vec3> positions) {
   auto it = targets_.find(id);
-  if (it == targets_.end() || it->second.distance == nullptr) return Status::invalid_argument;
-  if (Status s = it->second.distance->updatePositions(positions); s != Status::ok) return s;
-  it->second.bounds = computeBounds(positions);
-  ++it->second.version;
+  if (it == targets_.end() || !it->second.meshTarget) return Status::invalid_argument;
+  Target& t = it->second;
+  if (worker_ != nullptr) {
+    // The refit is the worker's, before its next build of this target (latest positions win).
+    if (positions.size() != t.vertexCount) return Status::invalid_argument;
+    if (t.deviceCopy != nullptr) {
+      std::copy(positions.begin(), positions.end(), t.deviceCopy->positions.begin());
+    }
+    t.bounds = computeBounds(positions);
+    ++t.version;
+    worker_->updateVertices(id, std::vector<glm::vec3>(positions.begin(), positions.end()),
+                            t.version);
+    return Status::ok;
+  }
+  if (Status s = t.distance->updatePositions(positions); s != Status::ok) return s;
+  t.bounds = computeBounds(positions);
+  ++t.version;
   return Status::ok;
+}
+
+Status GraspSession::updateTargetVertices(uint64_t id, std::vector<glm::vec3>&& positions,
+                                          const Aabb& bounds) {
+  if (worker_ == nullptr) return updateTargetVertices(id, std::span<const glm::vec3>(positions));
+  auto it = targets_.find(id);
+  if (it == targets_.end() || !it->second.meshTarget) return Status::invalid_argument;
+  Target& t = it->second;
+  if (positions.size() != t.vertexCount) return Status::invalid_argument;
+  if (t.deviceCopy != nullptr)
+    std::copy(positions.begin(), positions.end(), t.deviceCopy->positions.begin());
+  t.bounds = bounds;
+  ++t.version;
+  worker_->updateVertices(id, std::move(positions), t.version);
+  return Status::ok;
+}
+
+std::vector<glm::vec3> GraspSession::vertexBuffer(uint64_t id) {
+  return worker_ != nullptr ? worker_->spareBuffer(id) : std::vector<glm::vec3>{};
 }
 
 bool GraspSession::removeTarget(uint64_t id) {
@@ -140,6 +236,7 @@ bool GraspSession::removeTarget(uint64_t id) {
       hands_[h].grasp = HandGrasp{};
     }
   }
+  if (worker_ != nullptr) worker_->removeTarget(id);
   return targets_.erase(id) != 0;
 }
 
@@ -164,7 +261,9 @@ std::optional<uint64_t> GraspSession::pickTarget(Hand side, const Pose& worldFro
   float bestDistance = std::numeric_limits<float>::infinity();
   for (const TargetFrame& t : targets) {
     auto it = targets_.find(t.id);
-    if (!t.valid || it == targets_.end() || !it->second.hands[size_t(side)]) continue;
+    if (!t.valid || it == targets_.end() || it->second.setup != TargetSetup::ready ||
+        !it->second.hands[size_t(side)])
+      continue;
     const Pose boxFromObject = boxFromWorld * t.worldFromObject;
     // The target's bounds, as a box-space AABB of its 8 corners, must overlap the grab box.
     glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
@@ -183,22 +282,81 @@ std::optional<uint64_t> GraspSession::pickTarget(Hand side, const Pose& worldFro
   return best;
 }
 
+Status GraspSession::prepareSolver(HandState& hand) {
+  if (hand.prepared) return Status::ok;
+  if (worker_ != nullptr) {
+    // The worker may be solving with the current one: a new one, prepared by the worker.
+    auto made = createSolver(settings_.solver);
+    if (!made) return made.error().code;
+    auto setup = std::make_shared<GraspWorker::SolverSetup>();
+    setup->solver = std::move(*made);
+    setup->model = hand.model;
+    setup->box = settings_.box;
+    setup->options = settings_.solverOptions;
+    hand.workerSolver = std::move(setup);
+    hand.prepared = true;
+    return Status::ok;
+  }
+  if (Status s = hand.solver->prepare(hand.model, settings_.box, settings_.solverOptions);
+      s != Status::ok)
+    return s;
+  hand.prepared = true;
+  return Status::ok;
+}
+
+void GraspSession::post(HandState& hand, size_t slot, uint64_t id, const Pose& objectFromHand,
+                        std::optional<SdfGrid> field, bool gpu, int64_t time) {
+  GraspWorker::Job job;
+  job.time = time;
+  job.ticket = ++hand.ticket;
+  job.target = id;
+  job.objectFromHand = objectFromHand;
+  job.box = settings_.box;
+  job.solver = hand.workerSolver;
+  job.exactCheck = settings_.exactCheck;
+  job.field = std::move(field);
+  worker_->request(slot, std::move(job));
+  hand.jobPending = true;
+  hand.jobOnGpu = gpu;
+}
+
+Status GraspSession::collectJob(HandState& hand, size_t slot) {
+  if (!hand.jobPending || worker_ == nullptr) return Status::ok;
+  std::optional<GraspWorker::Done> done = worker_->take(slot);
+  if (!done) return Status::ok;
+  if (done->ticket != hand.ticket) return Status::ok;  // of a cancelled job
+  hand.jobPending = false;
+  if (done->built) ++stats_.cpuBuilds;
+  if (done->reused) ++stats_.reusedFields;
+  if (hand.jobOnGpu) ++stats_.gpuBuilds;
+  if (!hand.grasp.holding) return Status::ok;
+  if (done->status != Status::ok) {
+    hand.grasp = HandGrasp{};
+    return done->status;
+  }
+  hand.grasp.result = done->result;
+  hand.grasp.contacts = done->contacts;
+  hand.grasp.time = done->time;
+  hand.grasp.objectFromHand = done->objectFromHand;
+  hand.grasp.builtOnGpu = hand.jobOnGpu;
+  hand.solvedVersion = done->version;
+  ++hand.grasp.solves;
+  return Status::ok;
+}
+
 Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Target& target,
                            const Pose& objectFromHand) {
-  if (!hand.prepared) {
-    if (Status s = hand.solver->prepare(hand.model, settings_.box, settings_.solverOptions);
-        s != Status::ok)
-      return s;
-    hand.prepared = true;
-  }
-  const bool onDevice = deferredUsable() && (target.distance == nullptr || deferredForMeshTargets_);
+  if (Status s = prepareSolver(hand); s != Status::ok) return s;
+  const bool onDevice = deferredUsable() && (!target.meshTarget || deferredForMeshTargets_);
   if (onDevice && !deferredReady()) {
     // Still preparing (pipelines made at session start): a device target waits for it, asked
     // again at the next update; a target with a CPU mesh is built on the CPU below rather than
     // keep the hand waiting. A preparation that failed leaves the CPU only.
-    if (target.distance == nullptr && deferredUsable()) return Status::ok;
+    if (!target.meshTarget && deferredUsable()) return Status::ok;
   } else if (onDevice) {
-    const TriangleMesh* mesh = target.distance ? &target.distance->mesh() : nullptr;
+    const TriangleMesh* mesh = target.distance     ? &target.distance->mesh()
+                               : target.deviceCopy ? target.deviceCopy.get()
+                                                   : nullptr;
     const Status s =
         deferred_->request(slot, id, target.version, mesh, objectFromHand, settings_.box);
     if (s == Status::ok) {
@@ -213,7 +371,11 @@ Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Targ
     if (s == Status::invalid_argument) return s;
     stats_.gpuFailed = true;  // the device failed: this and every later build on the CPU
   }
-  if (target.distance == nullptr) return Status::device_lost;
+  if (!target.meshTarget) return Status::device_lost;
+  if (worker_ != nullptr) {
+    post(hand, slot, id, objectFromHand, std::nullopt, false, hand.frameTime);
+    return Status::ok;
+  }
   if (Status s = backend_->build(*target.distance, objectFromHand, settings_.box, hand.grid);
       s != Status::ok)
     return s;
@@ -256,6 +418,12 @@ Status GraspSession::collect(HandState& hand, size_t slot) {
   auto it = hand.grasp.holding ? targets_.find(hand.grasp.target) : targets_.end();
   if (it == targets_.end()) return Status::ok;
   if (p == BuildPoll::ready) {
+    if (worker_ != nullptr) {
+      // The solve, with its exact check, is the worker's too; the build counts once its grasp
+      // is taken (collectJob), so the count says the grasp shown has it.
+      post(hand, slot, it->first, hand.pendingPose, hand.grid, true, hand.pendingTime);
+      return Status::ok;
+    }
     ++stats_.gpuBuilds;
     // A result for older vertices is still shown; the next update asks again.
     return solveWithGrid(hand, hand.pendingPose, hand.pendingVersion, true,
@@ -263,9 +431,13 @@ Status GraspSession::collect(HandState& hand, size_t slot) {
   }
   // The device failed (or lost the request): redo the build on the CPU now.
   if (p == BuildPoll::failed) stats_.gpuFailed = true;
-  if (it->second.distance == nullptr) {
+  if (!it->second.meshTarget) {
     hand.grasp = HandGrasp{};
     return Status::device_lost;
+  }
+  if (worker_ != nullptr) {
+    post(hand, slot, it->first, hand.pendingPose, std::nullopt, false, hand.pendingTime);
+    return Status::ok;
   }
   if (Status s = backend_->build(*it->second.distance, hand.pendingPose, settings_.box, hand.grid);
       s != Status::ok) {
@@ -283,7 +455,11 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   HandState& hand = hands_[slot];
   hand.squeeze = std::isfinite(frame.squeeze) ? frame.squeeze : 0.0f;
   hand.frameTime = frame.time;
-  const Status collected = collect(hand, slot);
+  refreshSetups();
+  Status collected = collectJob(hand, slot);
+  // A failed job left the hand open: it stays so for this frame (the caller logs why).
+  if (collected != Status::ok) return collected;
+  collected = collect(hand, slot);
   if (hand.grasp.holding) {
     auto it = targets_.find(hand.grasp.target);
     if (it == targets_.end() || !it->second.hands[slot] ||
@@ -297,8 +473,10 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
       if (t.id == hand.grasp.target && t.valid) located = &t;
     }
     if (!frame.valid || located == nullptr) return collected;  // keep the last solve
-    if (hand.pending) return collected;  // the build in flight first, then re-check
     const Pose objectFromHand = located->worldFromObject.inverse() * frame.worldFromWrist;
+    hand.objectFromHandNow = objectFromHand;
+    // The build in flight first, then re-check.
+    if (hand.pending || hand.jobPending) return collected;
     const bool moved =
         glm::length(objectFromHand.position - hand.grasp.objectFromHand.position) >
             settings_.moveTolerance ||
@@ -333,8 +511,9 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   hand.grasp = HandGrasp{};
   hand.grasp.holding = true;
   hand.grasp.target = *id;
-  const Status s =
-      solve(hand, slot, *id, target, located->worldFromObject.inverse() * frame.worldFromWrist);
+  const Pose objectFromHand = located->worldFromObject.inverse() * frame.worldFromWrist;
+  hand.objectFromHandNow = objectFromHand;
+  const Status s = solve(hand, slot, *id, target, objectFromHand);
   if (s != Status::ok) {
     cancelPending(hand, slot);
     hand.grasp = HandGrasp{};

@@ -7,6 +7,14 @@
 // the squeeze drops below threshold * releaseRatio or the target goes away. While held, the grasp
 // is solved again when the target moves relative to the hand or its vertices change.
 //
+// Threading (GraspThreading): with `caller`, CPU builds and solves run inside update() on the
+// caller's thread (unit tests, tools). With `worker` (the layer), a GraspWorker owned by the
+// session runs the target set-up (addTarget returns at once; the target is graspable once
+// targetSetup() says ready), the refit after new vertices, the CPU builds and every solve with its
+// exact check; update() only hands the frame's poses over and takes the newest finished result,
+// never waiting. Until a newer result arrives a hand keeps its last solve (reposeCorrection()
+// says how to keep it on a target that moved since).
+//
 // SDF builds: on the CPU backend during update(); or, with a DeferredSdfBackend (the app's Vulkan
 // device), requested during update(), submitted by the owner through submitDeferred() where it
 // may use the queue, and collected by a later update() (one frame or more of latency; a hand
@@ -18,6 +26,8 @@
 // Not thread-safe: the owner serializes calls (the layer holds its session lock).
 #pragma once
 
+#include <chrono>
+
 #include <array>
 #include <cstdint>
 #include <map>
@@ -25,9 +35,12 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "base/status.h"
 #include "grasp/contact.h"
+#include "grasp/grasp_worker.h"
 #include "grasp/solver.h"
 #include "hand/hand_model.h"
 #include "mesh/mesh.h"
@@ -88,9 +101,16 @@ struct HandGrasp {
 
 // Where the session's grab-box SDFs were built so far.
 struct SdfBuildStats {
-  uint64_t gpuBuilds = 0;  // results collected from the deferred backend
-  uint64_t cpuBuilds = 0;  // builds on the CPU backend
-  bool gpuFailed = false;  // the deferred backend failed; the CPU builds from then on
+  uint64_t gpuBuilds = 0;     // results collected from the deferred backend
+  uint64_t cpuBuilds = 0;     // builds on the CPU backend
+  uint64_t reusedFields = 0;  // solves on an earlier CPU field moved rigidly (no build; worker)
+  bool gpuFailed = false;     // the deferred backend failed; the CPU builds from then on
+};
+
+// Where the CPU builds and the solves run (see the top of this file).
+enum class GraspThreading {
+  caller,  // inside update(), on the caller's thread
+  worker,  // on a thread owned by the session; update() never waits
 };
 
 class GraspSession {
@@ -98,7 +118,8 @@ class GraspSession {
   // `backend`: the CPU builder (always needed: headless sessions and the fallback). `deferred`:
   // optional device backend used first while it works.
   explicit GraspSession(std::unique_ptr<SdfBackend> backend,
-                        std::unique_ptr<DeferredSdfBackend> deferred = nullptr);
+                        std::unique_ptr<DeferredSdfBackend> deferred = nullptr,
+                        GraspThreading threading = GraspThreading::caller);
   ~GraspSession();
   GraspSession(const GraspSession&) = delete;
   GraspSession& operator=(const GraspSession&) = delete;
@@ -108,8 +129,18 @@ class GraspSession {
   Status configure(const GraspSettings& settings);
   const GraspSettings& settings() const { return settings_; }
 
-  // Targets are keyed by the caller's id; the mesh must have passed makeMesh().
-  Status addTarget(uint64_t id, const TriangleMesh& mesh);
+  // Targets are keyed by the caller's id; the mesh must have passed makeMesh(). With a worker the
+  // set-up (bounds, BVH, exact distance) runs there: the target is not graspable until
+  // targetSetup() says ready, and a set-up failure is reported once by takeSetupFailures().
+  Status addTarget(uint64_t id, TriangleMesh mesh);
+  // ready for targets set up in addTarget (caller threading) and device targets.
+  TargetSetup targetSetup(uint64_t id) const;
+  // Targets whose set-up failed since the last call, with the reason (each reported once).
+  std::vector<std::pair<uint64_t, std::string>> takeSetupFailures();
+  // With a worker: waits until it has nothing queued or running, at most `timeout` (tests and
+  // tools only; false on timeout). True at once without one.
+  bool waitWorkerIdle(std::chrono::milliseconds timeout) const;
+  bool usesWorker() const { return worker_ != nullptr; }
   // A target whose mesh exists only in the deferred backend (registered there under `id`, e.g.
   // the app's Vulkan buffers). `bounds` (target frame) must contain the mesh at all times; it
   // decides whether the target is in a grab box. Errors: invalid_argument (id in use, bad
@@ -125,6 +156,12 @@ class GraspSession {
   // holding it that may no longer lets go at its next update. Errors: invalid_argument (unknown
   // id).
   Status setTargetHands(uint64_t id, bool left, bool right);
+  // The same, handing over `positions` and their bounds (computed by the caller while it filled
+  // them): with a worker nothing is copied. Fill a buffer from vertexBuffer() to allocate nothing.
+  Status updateTargetVertices(uint64_t id, std::vector<glm::vec3>&& positions, const Aabb& bounds);
+  // A buffer the worker is done with, sized for target `id`'s positions when it has one (empty
+  // without a worker or before the first update).
+  std::vector<glm::vec3> vertexBuffer(uint64_t id);
   // Removes the target; a hand holding it lets go. Returns false for an unknown id.
   bool removeTarget(uint64_t id);
   bool hasTarget(uint64_t id) const { return targets_.count(id) != 0; }
@@ -155,13 +192,24 @@ class GraspSession {
   int pendingBuilds() const { return int(hands_[0].pending) + int(hands_[1].pending); }
 
   const HandGrasp& grasp(Hand hand) const { return hands_[size_t(hand)].grasp; }
+  // How to show the hand's last solve on a target that moved relative to the hand since (its
+  // result is being re-solved): the pose, in the current hand frame, of the hand frame the solve
+  // was made in (currentHandFromSolvedHand). Drawing the hand there keeps every contact on the
+  // target's surface, off the controller by the motion since the solve. Nothing when the target
+  // moved less than the re-solve tolerances (the solve is shown as it is).
+  std::optional<Pose> reposeCorrection(Hand hand) const;
   // The model the hand's grasp was solved with (default adult until a tracked grab fits one).
   const HandModel& model(Hand hand) const { return hands_[size_t(hand)].model; }
   float lastSqueeze(Hand hand) const { return hands_[size_t(hand)].squeeze; }
 
  private:
   struct Target {
-    std::unique_ptr<MeshDistance> distance;  // null for device targets
+    std::unique_ptr<MeshDistance> distance;  // null for device targets and with a worker
+    bool meshTarget = false;                 // CPU arrays (addTarget), not device buffers
+    TargetSetup setup = TargetSetup::ready;
+    // With a worker and a deferred backend that builds mesh targets: the arrays it uploads.
+    std::unique_ptr<TriangleMesh> deviceCopy;
+    size_t vertexCount = 0;  // with a worker: what updateTargetVertices must match
     Aabb bounds;
     uint64_t version = 0;
     std::array<bool, 2> hands{true, true};  // graspable by the left, the right hand
@@ -169,8 +217,17 @@ class GraspSession {
   struct HandState {
     HandModel model;
     std::unique_ptr<GraspSolver> solver;
+    // With a worker: the solver it prepares and solves with (replaced, never changed, by the
+    // owner once handed over).
+    std::shared_ptr<GraspWorker::SolverSetup> workerSolver;
     bool prepared = false;
     HandGrasp grasp;
+    // The target's pose relative to the hand at the last update (for reposeCorrection).
+    std::optional<Pose> objectFromHandNow;
+    // A job handed to the worker and not yet collected, and whether its field came from the GPU.
+    bool jobPending = false;
+    bool jobOnGpu = false;
+    uint64_t ticket = 0;
     uint64_t solvedVersion = 0;
     float squeeze = 0.0f;
     SdfGrid grid;
@@ -190,6 +247,13 @@ class GraspSession {
                        const MeshDistance* exactMesh, int64_t time);
   // Collects the hand's deferred build, if any; on a device failure redoes it on the CPU.
   Status collect(HandState& hand, size_t slot);
+  // Takes the worker's finished job for the hand, if any.
+  Status collectJob(HandState& hand, size_t slot);
+  // Hands a build (none when `field` is set) and solve to the worker.
+  void post(HandState& hand, size_t slot, uint64_t id, const Pose& objectFromHand,
+            std::optional<SdfGrid> field, bool gpu, int64_t time);
+  Status prepareSolver(HandState& hand);
+  void refreshSetups();
   void cancelPending(HandState& hand, size_t slot);
   // The target a grab of `side` takes: among those the hand may grasp whose bounds overlap the
   // grab box, the one whose bounds' centre is nearest the box's centre (ties: the first in
@@ -204,6 +268,8 @@ class GraspSession {
   GraspSettings settings_;
   std::map<uint64_t, Target> targets_;
   std::array<HandState, 2> hands_;
+  std::vector<std::pair<uint64_t, std::string>> setupFailures_;
+  std::unique_ptr<GraspWorker> worker_;  // last: joined before anything it could reach goes
 };
 
 }  // namespace sdfg

@@ -115,6 +115,12 @@ struct GraspScene {
   // Optional exact distance of the same target (scene hand frame). "ours" checks and corrects
   // its stops with it; null: the field alone, as before. Other strategies ignore it.
   const ExactDistanceSource* exact = nullptr;
+  // Where the field was built: maps scene hand points into the hand frame `field` was built in
+  // (identity: built for this scene). A field of the same rigid target built at another relative
+  // pose is the same distance function, so "ours" samples it through this map instead of a new
+  // build; the caller must make sure the box still covers the fingers there. Other strategies
+  // need identity.
+  Pose fieldFromHand{};
 };
 
 class GraspSolver {

@@ -212,7 +212,7 @@ Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {
   }
   glm::mat3 toBox;
   glm::vec3 toBoxOffset;
-  normalizedMap(field.box(), out.handCorrection, toBox, toBoxOffset);
+  normalizedMap(field.box(), scene.fieldFromHand * out.handCorrection, toBox, toBoxOffset);
   const FastSampler sampler(field);
   ExactContext cx;
   cx.source = scene.exact;

@@ -8,6 +8,27 @@
 
 namespace sdfg {
 
+std::optional<Error> findDegenerateTriangle(std::span<const glm::vec3> positions,
+                                            std::span<const uint32_t> indices) {
+  for (size_t t = 0; t < indices.size() / 3; ++t) {
+    const uint32_t a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
+    if (a == b || b == c || a == c) {
+      return makeError(Status::invalid_argument, "mesh: triangle " + std::to_string(t) +
+                                                     " repeats a vertex (" + std::to_string(a) +
+                                                     ", " + std::to_string(b) + ", " +
+                                                     std::to_string(c) + ")");
+    }
+    // Zero area in double precision: the three corners are collinear (or coincide).
+    const glm::dvec3 pa(positions[a]), pb(positions[b]), pc(positions[c]);
+    const glm::dvec3 n = glm::cross(pb - pa, pc - pa);
+    if (n.x == 0.0 && n.y == 0.0 && n.z == 0.0) {
+      return makeError(Status::invalid_argument,
+                       "mesh: triangle " + std::to_string(t) + " has zero area");
+    }
+  }
+  return std::nullopt;
+}
+
 std::optional<Error> validateMesh(std::span<const glm::vec3> positions,
                                   std::span<const uint32_t> indices) {
   if (positions.empty() || indices.empty()) {
@@ -35,23 +56,7 @@ std::optional<Error> validateMesh(std::span<const glm::vec3> positions,
                            std::to_string(positions.size()) + " vertices");
     }
   }
-  for (size_t t = 0; t < indices.size() / 3; ++t) {
-    const uint32_t a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
-    if (a == b || b == c || a == c) {
-      return makeError(Status::invalid_argument, "mesh: triangle " + std::to_string(t) +
-                                                     " repeats a vertex (" + std::to_string(a) +
-                                                     ", " + std::to_string(b) + ", " +
-                                                     std::to_string(c) + ")");
-    }
-    // Zero area in double precision: the three corners are collinear (or coincide).
-    const glm::dvec3 pa(positions[a]), pb(positions[b]), pc(positions[c]);
-    const glm::dvec3 n = glm::cross(pb - pa, pc - pa);
-    if (n.x == 0.0 && n.y == 0.0 && n.z == 0.0) {
-      return makeError(Status::invalid_argument,
-                       "mesh: triangle " + std::to_string(t) + " has zero area");
-    }
-  }
-  return std::nullopt;
+  return findDegenerateTriangle(positions, indices);
 }
 
 Result<TriangleMesh> makeMesh(std::span<const glm::vec3> positions,

@@ -38,6 +38,11 @@ struct Aabb {
 std::optional<Error> validateMesh(std::span<const glm::vec3> positions,
                                   std::span<const uint32_t> indices);
 
+// The degenerate-triangle part of validateMesh() alone, for new positions of a topology already
+// validated (indices in range): the first triangle that repeats a vertex or has zero area.
+std::optional<Error> findDegenerateTriangle(std::span<const glm::vec3> positions,
+                                            std::span<const uint32_t> indices);
+
 // Validates and copies the arrays into a mesh. Nothing is built when validation fails.
 Result<TriangleMesh> makeMesh(std::span<const glm::vec3> positions,
                               std::span<const uint32_t> indices);

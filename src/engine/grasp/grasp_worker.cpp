@@ -1,0 +1,354 @@
+#include "grasp/grasp_worker.h"
+
+#include <algorithm>
+#include <limits>
+#include <new>
+
+#ifdef __linux__
+#include <pthread.h>
+#include <sched.h>
+#endif
+
+namespace sdfg {
+namespace {
+
+// The box a field is built in when the target already moved in the hand: the same box grown by
+// kFieldMargin spacings on every side (same spacing, more nodes), so the next rigid motions of up
+// to that margin still find every node of the job's own box inside it (reuseMap).
+constexpr int kFieldMargin = 2;
+
+GridBox grownBox(const GridBox& box) {
+  GridBox grown = box;
+  const glm::vec3 spacing = box.spacing();
+  grown.resolution = box.resolution + glm::uvec3(2 * kFieldMargin);
+  if (glm::any(glm::greaterThan(grown.resolution, glm::uvec3(kMaxGridResolution)))) return box;
+  grown.size = box.size + spacing * float(2 * kFieldMargin);
+  return grown;
+}
+
+}  // namespace
+
+GraspWorker::GraspWorker(std::unique_ptr<SdfBackend> backend) : backend_(std::move(backend)) {
+  thread_ = std::thread([this] { run(); });
+}
+
+GraspWorker::~GraspWorker() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  thread_.join();
+}
+
+void GraspWorker::addTarget(uint64_t id, TriangleMesh mesh) {
+  auto t = std::make_shared<Target>();
+  t->setupMesh = std::move(mesh);
+  {
+    std::lock_guard lock(mutex_);
+    targets_[id] = std::move(t);
+    setups_.push_back(id);
+  }
+  wake_.notify_all();
+}
+
+void GraspWorker::updateVertices(uint64_t id, std::vector<glm::vec3> positions, uint64_t version) {
+  std::lock_guard lock(mutex_);
+  auto it = targets_.find(id);
+  if (it == targets_.end()) return;
+  Target& t = *it->second;
+  // Positions nobody built with yet are replaced; their buffer is kept for the next update.
+  if (t.positions) t.spares.push_back(std::move(*t.positions));
+  t.positions = std::move(positions);
+  t.positionsVersion = version;
+}
+
+std::vector<glm::vec3> GraspWorker::spareBuffer(uint64_t id) {
+  std::lock_guard lock(mutex_);
+  auto it = targets_.find(id);
+  if (it == targets_.end() || it->second->spares.empty()) return {};
+  std::vector<glm::vec3> out = std::move(it->second->spares.back());
+  it->second->spares.pop_back();
+  return out;
+}
+
+void GraspWorker::removeTarget(uint64_t id) {
+  std::shared_ptr<Target> dropped;  // freed outside the lock: a big mesh takes a while
+  {
+    std::lock_guard lock(mutex_);
+    auto it = targets_.find(id);
+    if (it == targets_.end()) return;
+    dropped = std::move(it->second);
+    targets_.erase(it);
+  }
+}
+
+GraspWorker::TargetInfo GraspWorker::targetInfo(uint64_t id) const {
+  std::lock_guard lock(mutex_);
+  auto it = targets_.find(id);
+  if (it == targets_.end()) return {};
+  return {it->second->setup, it->second->bounds, it->second->error};
+}
+
+void GraspWorker::request(size_t slot, Job job) {
+  {
+    std::lock_guard lock(mutex_);
+    slots_[slot].queued = std::move(job);
+  }
+  wake_.notify_all();
+}
+
+void GraspWorker::cancel(size_t slot) {
+  std::lock_guard lock(mutex_);
+  Slot& s = slots_[slot];
+  s.queued.reset();
+  s.done.reset();
+  if (s.running) s.cancelledBelow = s.runningTicket + 1;
+}
+
+std::optional<GraspWorker::Done> GraspWorker::take(size_t slot) {
+  // Polled every frame from the app's thread: never wait for the worker (which may have been
+  // preempted while holding the lock); the result is taken at the next poll instead.
+  std::unique_lock lock(mutex_, std::try_to_lock);
+  if (!lock.owns_lock()) return std::nullopt;
+  std::optional<Done> out = std::move(slots_[slot].done);
+  slots_[slot].done.reset();
+  return out;
+}
+
+bool GraspWorker::waitIdle(std::chrono::milliseconds timeout) const {
+  std::unique_lock lock(mutex_);
+  return idle_.wait_for(lock, timeout, [&] {
+    return !busy_ && setups_.empty() && !slots_[0].queued && !slots_[1].queued;
+  });
+}
+
+uint64_t GraspWorker::setupsDone() const {
+  std::lock_guard lock(mutex_);
+  return setupsDone_;
+}
+
+uint64_t GraspWorker::jobsDone() const {
+  std::lock_guard lock(mutex_);
+  return jobsDone_;
+}
+
+std::optional<Pose> GraspWorker::reuseMap(const BuiltField& built, const Job& job,
+                                          uint64_t version) {
+  if (!built.valid || built.target != job.target || built.version != version) return std::nullopt;
+  if (!job.solver->reusesFields || built.jobBox.resolution != job.box.resolution ||
+      built.jobBox.size != job.box.size ||
+      built.jobBox.handFromBox.position != job.box.handFromBox.position ||
+      built.jobBox.handFromBox.orientation != job.box.handFromBox.orientation)
+    return std::nullopt;
+  // field hand <- object <- job hand: the same surface, seen from where the field was built.
+  const Pose fieldFromHand = built.objectFromHand.inverse() * job.objectFromHand;
+  // Every node of the job's own box must lie inside the built one, so everything a fresh field
+  // would tell the solver, this one tells too (beyond the job's box it tells more: the solver
+  // reads real values there instead of the border's). Its corners are the extreme points.
+  const GridBox& box = built.grid.box();
+  const Pose builtFromJobBox = box.handFromBox.inverse() * fieldFromHand * job.box.handFromBox;
+  const glm::vec3 half = job.box.size * 0.5f;
+  const glm::vec3 limit = box.size * 0.5f + glm::vec3(1e-6f);
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec3 corner((c & 1) ? half.x : -half.x, (c & 2) ? half.y : -half.y,
+                           (c & 4) ? half.z : -half.z);
+    const glm::vec3 p = builtFromJobBox.transformPoint(corner);
+    if (glm::any(glm::greaterThan(glm::abs(p), limit))) return std::nullopt;
+  }
+  return fieldFromHand;
+}
+
+void GraspWorker::run() {
+#ifdef __linux__
+  // SCHED_BATCH: the kernel does not let this thread preempt the one that woke it, so handing a
+  // job over never costs the app's thread the rest of its time slice (measured: a 0.7 ms stall
+  // in xrSyncActions on a busy 2-core machine without it). Same nice value, same share of CPU.
+  // Best effort: the default policy is kept where it is refused.
+  sched_param param{};
+  param.sched_priority = 0;
+  (void)pthread_setschedparam(pthread_self(), SCHED_BATCH, &param);
+#endif
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    wake_.wait(lock,
+               [&] { return stop_ || !setups_.empty() || slots_[0].queued || slots_[1].queued; });
+    if (stop_) break;
+    busy_ = true;
+    if (!setups_.empty()) {
+      // Set-ups first: a target must be ready before any hand can grab it.
+      const uint64_t id = setups_.front();
+      setups_.pop_front();
+      auto it = targets_.find(id);
+      if (it != targets_.end() && it->second->setupMesh) runSetup(lock, id, it->second);
+    } else {
+      // The slots take turns, so one hand's stream of re-solves cannot starve the other's grab.
+      size_t slot = nextSlot_;
+      if (!slots_[slot].queued) slot = 1 - slot;
+      nextSlot_ = 1 - slot;
+      Job job = std::move(*slots_[slot].queued);
+      slots_[slot].queued.reset();
+      runJob(lock, slot, std::move(job));
+    }
+    busy_ = false;
+    if (setups_.empty() && !slots_[0].queued && !slots_[1].queued) idle_.notify_all();
+  }
+  busy_ = false;
+  idle_.notify_all();
+}
+
+void GraspWorker::runSetup(std::unique_lock<std::mutex>& lock, uint64_t id,
+                           std::shared_ptr<Target> target) {
+  TriangleMesh mesh = std::move(*target->setupMesh);
+  target->setupMesh.reset();
+  lock.unlock();
+  std::shared_ptr<MeshDistance> distance;
+  std::string error;
+  Aabb bounds;
+  try {
+    bounds = computeBounds(mesh.positions);
+    auto made = MeshDistance::create(mesh);
+    if (made)
+      distance = std::move(*made);
+    else
+      error = made.error().message;
+  } catch (const std::bad_alloc&) {
+    error = "out of memory";
+  } catch (...) {
+    error = "internal error";
+  }
+  mesh = TriangleMesh{};  // freed before the lock
+  lock.lock();
+  ++setupsDone_;
+  // Removed (or replaced by a new target of the same id) while it was set up: nothing to publish.
+  auto it = targets_.find(id);
+  if (it == targets_.end() || it->second != target) return;
+  if (distance != nullptr) {
+    target->distance = std::move(distance);
+    target->bounds = bounds;
+    target->setup = TargetSetup::ready;
+  } else {
+    target->setup = TargetSetup::failed;
+    target->error = error.empty() ? "the mesh was refused" : error;
+  }
+}
+
+void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job job) {
+  Slot& s = slots_[slot];
+  s.running = true;
+  s.runningTicket = job.ticket;
+  std::shared_ptr<Target> target;
+  std::optional<std::vector<glm::vec3>> positions;
+  uint64_t version = 0;
+  if (auto it = targets_.find(job.target);
+      it != targets_.end() && it->second->setup == TargetSetup::ready) {
+    target = it->second;
+    positions = std::move(target->positions);
+    target->positions.reset();
+    version = positions ? target->positionsVersion : target->appliedVersion;
+  }
+  // A deforming target: fill its pool of buffers here, off the app's thread.
+  const size_t missingSpares =
+      positions && target->spares.size() < 2 ? 2 - target->spares.size() : 0;
+  lock.unlock();
+  std::vector<std::vector<glm::vec3>> newSpares;
+  if (missingSpares > 0) {
+    try {
+      for (size_t i = 0; i < missingSpares; ++i) newSpares.emplace_back(positions->size());
+    } catch (const std::bad_alloc&) {
+      newSpares.clear();  // the app's thread allocates then, as without a pool
+    }
+  }
+
+  const auto start = std::chrono::steady_clock::now();
+  Done done;
+  done.ticket = job.ticket;
+  done.objectFromHand = job.objectFromHand;
+  done.time = job.time;
+  done.version = version;
+  std::optional<Aabb> refitBounds;
+  try {
+    MeshDistance* distance = target != nullptr ? target->distance.get() : nullptr;
+    if (distance != nullptr && positions) {
+      // A deformed mesh: refit the hierarchy (O(n)), as the app's thread did before the worker.
+      done.status = distance->updatePositions(*positions);
+      if (done.status == Status::ok) refitBounds = computeBounds(*positions);
+    }
+    const SdfGrid* field = job.field ? &*job.field : nullptr;
+    BuiltField& built = fields_[slot];
+    Pose fieldFromHand{};
+    if (done.status == Status::ok && field == nullptr) {
+      if (distance == nullptr) {
+        done.status = Status::invalid_argument;  // removed, or not set up
+      } else if (const auto map = reuseMap(built, job, version)) {
+        fieldFromHand = *map;
+        field = &built.grid;
+        done.reused = true;
+      } else {
+        // A re-solve of the same target and vertices means it moves in the hand: build a grown
+        // box, which the next motions reuse. A first grab builds the plain box (the fastest).
+        const bool moving = job.solver->reusesFields && built.valid && built.target == job.target &&
+                            built.version == version;
+        built.valid = false;
+        built.jobBox = job.box;
+        done.status = backend_->build(*distance, job.objectFromHand,
+                                      moving ? grownBox(job.box) : job.box, built.grid);
+        done.built = done.status == Status::ok;
+        if (done.built) {
+          built.valid = true;
+          built.target = job.target;
+          built.version = version;
+          built.objectFromHand = job.objectFromHand;
+        }
+        field = &built.grid;
+      }
+    }
+    if (done.status == Status::ok && job.solver == nullptr) done.status = Status::internal;
+    if (done.status == Status::ok && !job.solver->prepared) {
+      SolverSetup& setup = *job.solver;
+      setup.prepareStatus = setup.solver->prepare(setup.model, setup.box, setup.options);
+      setup.prepared = true;
+      setup.reusesFields = setup.solver->name() == "ours" && !setup.options.approach;
+    }
+    if (done.status == Status::ok) done.status = job.solver->prepareStatus;
+    if (done.status == Status::ok) {
+      GraspScene scene;
+      scene.field = field;
+      scene.objectFromHand = job.objectFromHand;
+      scene.fieldFromHand = fieldFromHand;
+      std::optional<MeshExactSource> exact;
+      if (job.exactCheck && distance != nullptr) {
+        exact.emplace(*distance, job.objectFromHand);
+        scene.exact = &*exact;
+      }
+      done.status = job.solver->solver->solve(scene, done.result);
+      // The field answers contacts only where no mesh does, and only in the frame it was built
+      // in (a reused field was built at another relative pose).
+      if (done.status == Status::ok)
+        done.contacts = computeContacts(job.solver->model, done.result, job.objectFromHand,
+                                        distance, done.reused ? nullptr : field);
+    }
+  } catch (const std::bad_alloc&) {
+    done.status = Status::out_of_memory;
+  } catch (...) {
+    done.status = Status::internal;
+  }
+  done.duration = std::chrono::duration_cast<std::chrono::microseconds>(
+      std::chrono::steady_clock::now() - start);
+  job = Job{};  // the solver reference and any field go before the lock
+
+  lock.lock();
+  ++jobsDone_;
+  if (target != nullptr && positions) {
+    target->appliedVersion = version;
+    if (refitBounds) target->bounds = *refitBounds;
+    // The app's next updates fill these again.
+    target->spares.push_back(std::move(*positions));
+    for (auto& b : newSpares)
+      if (target->spares.size() < 3) target->spares.push_back(std::move(b));
+  }
+  s.running = false;
+  if (done.ticket >= s.cancelledBelow) s.done = std::move(done);
+}
+
+}  // namespace sdfg

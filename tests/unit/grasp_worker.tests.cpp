@@ -1,0 +1,361 @@
+// GraspSession with its worker (GraspThreading::worker, the layer's mode): the caller's update()
+// hands poses over and takes the newest finished result; set-ups, refits, builds and solves run
+// on the worker. No test counts updates until a result exists: each waits for the outcome with a
+// generous time bound (waitWorkerIdle, or a deadline).
+#include <catch2/catch.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <new>
+#include <thread>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "grasp/grasp_session.h"
+#include "grasp/grasp_worker.h"
+#include "io/shapes.h"
+#include "sdf/sdf_backend.h"
+
+namespace {
+
+using namespace sdfg;
+using namespace std::chrono_literals;
+
+// A right hand whose grab box is centred on the target at the origin, squeezing.
+HandFrame squeezing(float squeeze) {
+  HandFrame f;
+  f.valid = true;
+  f.squeeze = squeeze;
+  f.worldFromWrist = GridBox::referenceDefault().handFromBox.inverse();
+  return f;
+}
+
+GraspSettings oursSettings() {
+  GraspSettings s;
+  s.solver = "ours";
+  return s;
+}
+
+// Updates the hand until `done` holds, at most 20 s; true when it held.
+template <class F>
+bool updateUntil(GraspSession& session, const HandFrame& frame, const TargetFrame& target, F done) {
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (std::chrono::steady_clock::now() < deadline) {
+    REQUIRE(session.update(Hand::right, frame, {&target, 1}) == Status::ok);
+    if (done()) return true;
+    std::this_thread::sleep_for(1ms);
+  }
+  return false;
+}
+
+int contacts(const HandGrasp& g) {
+  int n = 0;
+  for (const FingerState& f : g.result.fingers) n += f.contact ? 1 : 0;
+  return n;
+}
+
+// A CPU backend that blocks its builds until released, to hold a job on the worker.
+class GatedBackend final : public SdfBackend {
+ public:
+  explicit GatedBackend(std::shared_ptr<std::atomic<bool>> open)
+      : open_(std::move(open)), cpu_(makeCpuSdfBackend(1)) {}
+  std::string_view name() const override { return "gated"; }
+  Status build(const MeshDistance& target, const Pose& pose, const GridBox& box,
+               SdfGrid& out) override {
+    while (!open_->load()) std::this_thread::sleep_for(1ms);
+    return cpu_->build(target, pose, box, out);
+  }
+
+ private:
+  std::shared_ptr<std::atomic<bool>> open_;
+  std::unique_ptr<SdfBackend> cpu_;
+};
+
+}  // namespace
+
+TEST_CASE("GraspSession with a worker sets targets up off the caller's thread",
+          "[grasp_worker][core]") {
+  GraspSession session(makeCpuSdfBackend(1), nullptr, GraspThreading::worker);
+  REQUIRE(session.usesWorker());
+  REQUIRE(session.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
+  // Known at once, graspable once the worker has built its exact distance.
+  CHECK(session.hasTarget(7));
+  CHECK(session.targetSetup(7) != TargetSetup::unknown);
+  REQUIRE(session.waitWorkerIdle(20s));
+  CHECK(session.targetSetup(7) == TargetSetup::ready);
+  CHECK(session.targetSetup(8) == TargetSetup::unknown);
+  CHECK(session.takeSetupFailures().empty());
+  // A second id is refused as before.
+  CHECK(session.addTarget(7, makeSphere(0.04f, 3)) == Status::invalid_argument);
+}
+
+TEST_CASE("GraspSession with a worker grasps as the caller-thread session does",
+          "[grasp_worker][core]") {
+  const TargetFrame target{7, true, Pose{}};
+  GraspSession inline_(makeCpuSdfBackend(1));
+  REQUIRE(inline_.configure(oursSettings()) == Status::ok);
+  REQUIRE(inline_.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
+  REQUIRE(inline_.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+  const HandGrasp& expected = inline_.grasp(Hand::right);
+  REQUIRE(expected.solves == 1);
+
+  GraspSession session(makeCpuSdfBackend(1), nullptr, GraspThreading::worker);
+  REQUIRE(session.configure(oursSettings()) == Status::ok);
+  REQUIRE(session.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
+  REQUIRE(session.waitWorkerIdle(20s));
+  REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+  // Holding from the squeeze; the solve arrives later.
+  CHECK(session.grasp(Hand::right).holding);
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.grasp(Hand::right).solves > 0; }));
+  const HandGrasp& g = session.grasp(Hand::right);
+  CHECK(g.solves == 1);
+  CHECK(contacts(g) >= 3);
+  CHECK(session.buildStats().cpuBuilds == 1);
+  // Same solver, same field, same exact check: the same curls.
+  for (int f = 0; f < kFingerCount; ++f) {
+    CAPTURE(f);
+    CHECK(g.result.fingers[f].curl == Approx(expected.result.fingers[f].curl).margin(1e-6));
+  }
+  // Nothing moved: no new job.
+  REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+  REQUIRE(session.waitWorkerIdle(20s));
+  REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+  CHECK(session.grasp(Hand::right).solves == 1);
+}
+
+TEST_CASE("A target still being set up is not grabbed", "[grasp_worker][core]") {
+  auto open = std::make_shared<std::atomic<bool>>(false);
+  GraspSession session(std::make_unique<GatedBackend>(open), nullptr, GraspThreading::worker);
+  REQUIRE(session.configure(oursSettings()) == Status::ok);
+  const TargetFrame target{7, true, Pose{}};
+  // A large sphere keeps the worker busy on its set-up for a while; the check below does not
+  // depend on it (a ready target is grabbed, a pending one is not, both are valid outcomes).
+  REQUIRE(session.addTarget(7, makeSphere(0.04f, 6)) == Status::ok);
+  REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+  CHECK(session.grasp(Hand::right).holding == (session.targetSetup(7) == TargetSetup::ready));
+  open->store(true);
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.grasp(Hand::right).solves > 0; }));
+}
+
+TEST_CASE("A hand keeps its last solve while the next one runs, re-posed onto the target",
+          "[grasp_worker][core]") {
+  auto open = std::make_shared<std::atomic<bool>>(true);
+  GraspSession session(std::make_unique<GatedBackend>(open), nullptr, GraspThreading::worker);
+  REQUIRE(session.configure(oursSettings()) == Status::ok);
+  REQUIRE(session.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
+  REQUIRE(session.waitWorkerIdle(20s));
+  TargetFrame target{7, true, Pose{}};
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.grasp(Hand::right).solves > 0; }));
+  const GraspResult first = session.grasp(Hand::right).result;
+  CHECK_FALSE(session.reposeCorrection(Hand::right).has_value());
+
+  // The target moves 1 cm; its re-solve is held on the worker.
+  open->store(false);
+  target.worldFromObject.position = glm::vec3(0.0f, 0.0f, 0.01f);
+  REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+  for (int i = 0; i < 5; ++i) {
+    REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    const HandGrasp& g = session.grasp(Hand::right);
+    // Still holding, still the first solve: no open-hand flicker...
+    REQUIRE(g.holding);
+    REQUIRE(g.solves == 1);
+    CHECK(g.result.fingers[1].curl == first.fingers[1].curl);
+  }
+  // ...shown where the hand was relative to the target at that solve: the correction maps the
+  // solved hand frame into the current one, i.e. it moves the hand with the target.
+  const auto c = session.reposeCorrection(Hand::right);
+  REQUIRE(c.has_value());
+  const Pose worldFromWrist = squeezing(1.0f).worldFromWrist;
+  const glm::vec3 shifted = (worldFromWrist * *c).position - worldFromWrist.position;
+  CHECK(shifted.x == Approx(0.0f).margin(1e-5));
+  CHECK(shifted.y == Approx(0.0f).margin(1e-5));
+  CHECK(shifted.z == Approx(0.01f).margin(1e-5));
+
+  open->store(true);
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.grasp(Hand::right).solves >= 2; }));
+  CHECK_FALSE(session.reposeCorrection(Hand::right).has_value());
+}
+
+TEST_CASE("New vertices are refit on the worker and re-solved", "[grasp_worker][core]") {
+  GraspSession session(makeCpuSdfBackend(1), nullptr, GraspThreading::worker);
+  REQUIRE(session.configure(oursSettings()) == Status::ok);
+  TriangleMesh sphere = makeSphere(0.04f, 3);
+  REQUIRE(session.addTarget(7, sphere) == Status::ok);
+  REQUIRE(session.waitWorkerIdle(20s));
+  const TargetFrame target{7, true, Pose{}};
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.grasp(Hand::right).solves > 0; }));
+  const float before = session.grasp(Hand::right).result.fingers[2].curl;
+  // A smaller sphere: the fingers close further.
+  std::vector<glm::vec3> smaller = sphere.positions;
+  for (glm::vec3& p : smaller) p *= 0.75f;
+  REQUIRE(session.updateTargetVertices(7, smaller) == Status::ok);
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.grasp(Hand::right).solves >= 2; }));
+  CHECK(session.grasp(Hand::right).result.fingers[2].curl > before + 0.01f);
+  CHECK(session.updateTargetVertices(7, std::vector<glm::vec3>(3)) != Status::ok);
+}
+
+TEST_CASE("Releasing, removing the target or destroying the session while a job runs is safe",
+          "[grasp_worker][core]") {
+  auto open = std::make_shared<std::atomic<bool>>(true);
+  const TargetFrame target{7, true, Pose{}};
+  auto makeHeld = [&] {
+    auto session = std::make_unique<GraspSession>(std::make_unique<GatedBackend>(open), nullptr,
+                                                  GraspThreading::worker);
+    REQUIRE(session->configure(oursSettings()) == Status::ok);
+    REQUIRE(session->addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
+    REQUIRE(session->waitWorkerIdle(20s));
+    open->store(false);  // the grab's build waits on the worker
+    REQUIRE(session->update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    REQUIRE(session->grasp(Hand::right).holding);
+    return session;
+  };
+  SECTION("releasing drops the result of the job in flight") {
+    auto session = makeHeld();
+    REQUIRE(session->update(Hand::right, squeezing(0.0f), {&target, 1}) == Status::ok);
+    CHECK_FALSE(session->grasp(Hand::right).holding);
+    open->store(true);
+    REQUIRE(session->waitWorkerIdle(20s));
+    REQUIRE(session->update(Hand::right, squeezing(0.0f), {&target, 1}) == Status::ok);
+    CHECK_FALSE(session->grasp(Hand::right).holding);
+    CHECK(session->grasp(Hand::right).solves == 0);
+  }
+  SECTION("removing the target lets go; the job ends on its own reference") {
+    auto session = makeHeld();
+    CHECK(session->removeTarget(7));
+    CHECK_FALSE(session->grasp(Hand::right).holding);
+    open->store(true);
+    REQUIRE(session->waitWorkerIdle(20s));
+    REQUIRE(session->update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    CHECK_FALSE(session->grasp(Hand::right).holding);
+  }
+  SECTION("destroying the session joins the worker after its job") {
+    auto session = makeHeld();
+    std::thread opener([&] {
+      std::this_thread::sleep_for(20ms);
+      open->store(true);
+    });
+    session.reset();  // returns once the worker has ended; nothing runs after
+    opener.join();
+    SUCCEED("destroyed");
+  }
+  SECTION("destroying the session with set-ups queued drops them") {
+    open->store(true);
+    auto session = std::make_unique<GraspSession>(std::make_unique<GatedBackend>(open), nullptr,
+                                                  GraspThreading::worker);
+    for (uint64_t id = 1; id <= 8; ++id)
+      REQUIRE(session->addTarget(id, makeSphere(0.04f, 5)) == Status::ok);
+    session.reset();
+    SUCCEED("destroyed");
+  }
+}
+
+TEST_CASE("A failing job leaves the hand open and the worker working", "[grasp_worker][core]") {
+  // A backend that fails its first build, as a build over its time bound or out of memory would.
+  class FailingOnce final : public SdfBackend {
+   public:
+    std::string_view name() const override { return "failing-once"; }
+    Status build(const MeshDistance& t, const Pose& p, const GridBox& b, SdfGrid& out) override {
+      if (!failed_) {
+        failed_ = true;
+        throw std::bad_alloc();
+      }
+      return cpu_->build(t, p, b, out);
+    }
+
+   private:
+    bool failed_ = false;
+    std::unique_ptr<SdfBackend> cpu_ = makeCpuSdfBackend(1);
+  };
+  GraspSession session(std::make_unique<FailingOnce>(), nullptr, GraspThreading::worker);
+  REQUIRE(session.configure(oursSettings()) == Status::ok);
+  REQUIRE(session.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
+  REQUIRE(session.waitWorkerIdle(20s));
+  const TargetFrame target{7, true, Pose{}};
+  REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+  REQUIRE(session.waitWorkerIdle(20s));
+  CHECK(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::out_of_memory);
+  CHECK_FALSE(session.grasp(Hand::right).holding);
+  // The next squeeze grabs again.
+  session.release(Hand::right);
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.grasp(Hand::right).solves > 0; }));
+}
+
+TEST_CASE("A mesh the worker cannot set up is reported once and never grabbed",
+          "[grasp_worker][core]") {
+  GraspWorker worker(makeCpuSdfBackend(1));
+  TriangleMesh bad;  // no triangles: MeshDistance refuses it
+  bad.positions = {glm::vec3(0.0f), glm::vec3(1.0f, 0, 0), glm::vec3(0, 1.0f, 0)};
+  worker.addTarget(3, bad);
+  REQUIRE(worker.waitIdle(20s));
+  const GraspWorker::TargetInfo info = worker.targetInfo(3);
+  CHECK(info.setup == TargetSetup::failed);
+  CHECK_FALSE(info.error.empty());
+  CHECK(worker.setupsDone() == 1);
+}
+
+TEST_CASE("A rigid motion of a held target re-solves on the field already built",
+          "[grasp_worker][core]") {
+  const TriangleMesh sphere = makeSphere(0.04f, 3);
+  GraspSession session(makeCpuSdfBackend(1), nullptr, GraspThreading::worker);
+  REQUIRE(session.configure(oursSettings()) == Status::ok);
+  REQUIRE(session.addTarget(7, sphere) == Status::ok);
+  REQUIRE(session.waitWorkerIdle(20s));
+  TargetFrame target{7, true, Pose{}};
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.grasp(Hand::right).solves > 0; }));
+  REQUIRE(session.buildStats().cpuBuilds == 1);
+
+  // The target starts moving in the hand: its next field is built in a grown box...
+  target.worldFromObject.position = glm::vec3(0.002f, 0.0f, 0.0f);
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.grasp(Hand::right).solves >= 2; }));
+  CHECK(session.buildStats().cpuBuilds == 2);
+  // ...which the next rigid motion (3 mm more and 2 degrees) solves on without a build.
+  target.worldFromObject.position = glm::vec3(0.005f, 0.0f, 0.0f);
+  target.worldFromObject.orientation = glm::angleAxis(glm::radians(2.0f), glm::vec3(0, 1, 0));
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.grasp(Hand::right).solves >= 3; }));
+  CHECK(session.buildStats().cpuBuilds == 2);
+  CHECK(session.buildStats().reusedFields == 1);
+  const GraspResult reused = session.grasp(Hand::right).result;
+
+  // The same placement solved on a field built for it: the same contacts, within what the exact
+  // check guarantees (its stops are on the mesh itself, 0.1 mm).
+  GraspSession fresh(makeCpuSdfBackend(1));
+  REQUIRE(fresh.configure(oursSettings()) == Status::ok);
+  REQUIRE(fresh.addTarget(7, sphere) == Status::ok);
+  REQUIRE(fresh.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+  const GraspResult& expected = fresh.grasp(Hand::right).result;
+  REQUIRE(fresh.grasp(Hand::right).solves == 1);
+  for (int f = 0; f < kFingerCount; ++f) {
+    CAPTURE(f);
+    CHECK(reused.fingers[f].contact == expected.fingers[f].contact);
+    if (!expected.fingers[f].contact) continue;
+    CHECK(glm::length(reused.fingers[f].contactPoint - expected.fingers[f].contactPoint) < 0.0005f);
+  }
+
+  // 15 cm away the field built does not hold the box: a new build.
+  target.worldFromObject = Pose{};
+  target.worldFromObject.position = glm::vec3(0.0f, 0.0f, 0.15f);
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.buildStats().cpuBuilds == 3; }));
+  CHECK(session.buildStats().reusedFields == 1);
+
+  // New vertices are a new object: a new build.
+  std::vector<glm::vec3> smaller = sphere.positions;
+  for (glm::vec3& p : smaller) p *= 0.9f;
+  target.worldFromObject = Pose{};
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.buildStats().cpuBuilds >= 4; }));
+  const uint64_t builds = session.buildStats().cpuBuilds;
+  REQUIRE(session.updateTargetVertices(7, smaller) == Status::ok);
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.buildStats().cpuBuilds > builds; }));
+}

@@ -337,7 +337,10 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
     const FingerState& fs = g.result.fingers[f];
     out.curl = held ? fs.curl : 0.0f;
     out.inContact = held && fs.contact ? XR_TRUE : XR_FALSE;
-    const glm::vec3 p = held ? g.objectFromHand.transformPoint(fs.contactPoint) : glm::vec3(0.0f);
+    // The contact is in the corrected hand frame (the hand may have been moved out first).
+    const glm::vec3 p =
+        held ? (g.objectFromHand * g.result.handCorrection).transformPoint(fs.contactPoint)
+             : glm::vec3(0.0f);
     out.contactPoint = {p.x, p.y, p.z};
     out.distance = held ? fs.distance : 0.0f;
   }
@@ -353,6 +356,7 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
     info->gpuFailed = st.gpuFailed ? XR_TRUE : XR_FALSE;
     info->pendingGpuBuilds = uint32_t(s->grasp->pendingBuilds());
   }
+  writeHandOffset(*s, hand == Hand::left ? 0 : 1, state->next);
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)
 }
@@ -390,6 +394,8 @@ XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession session,
               XR_ERROR_VALIDATION_FAILURE, "(options->curlStep) must be 0 or in [1e-5, 1]");
   SDFG_VERIFY(cmd, o.grabThreshold == 0.0f || (o.grabThreshold > 0.0f && o.grabThreshold <= 1.0f),
               XR_ERROR_VALIDATION_FAILURE, "(options->grabThreshold) must be 0 or in (0, 1]");
+  ClearanceRequest clearance;
+  if (XrResult r = readClearanceOptions(cmd, o.next, clearance); r != XR_SUCCESS) return r;
 
   std::lock_guard lock(s->mutex);
   SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
@@ -404,6 +410,8 @@ XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession session,
   if (o.resolution != 0) settings.box.resolution = glm::uvec3(o.resolution);
   if (o.curlStep != 0.0f) settings.solverOptions.da = o.curlStep;
   if (o.grabThreshold != 0.0f) settings.grabThreshold = o.grabThreshold;
+  float blendTime = s->instance->config.offsetBlendTime;
+  clearance.apply(settings, blendTime);
   if (Status st = s->grasp->configure(settings); st != Status::ok)
     return logError(st == Status::invalid_argument && o.solver == XR_GRASP_SOLVER_OURS_SDFG
                         ? XR_ERROR_FEATURE_UNSUPPORTED
@@ -411,6 +419,7 @@ XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession session,
                     cmd, "the options were refused (%s; solver '%s')", toString(st),
                     settings.solver.c_str());
   s->settings = settings;
+  s->offsets.blendTime = blendTime;
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)
 }

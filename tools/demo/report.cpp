@@ -153,7 +153,8 @@ bool writeReports(const std::string& dir, const std::vector<ObjectResult>& objec
        << "img.slice{max-width:min(100%,512px)}.scroll{overflow-x:auto}"
        << "table{border-collapse:collapse;margin:8px 0;font-size:0.9em}"
        << "td,th{border:1px solid #bbb;padding:2px 8px;text-align:right}"
-       << "th{background:#eee}td:first-child,td:nth-child(2){text-align:left}"
+       << "th{background:#eee}td:first-child,td:nth-child(2),th:first-child,th:nth-child(2)"
+       << "{text-align:left}.caption{font-size:0.85em;color:#555}"
        << "code{font-family:monospace;background:#eee;padding:0 3px;border-radius:3px}"
        << ".fail{color:#b00}</style></head><body>\n"
        << "<h1>SDF Autograsp demo</h1>\n<p>" << inlineHtml(kExplain)
@@ -175,7 +176,9 @@ bool writeReports(const std::string& dir, const std::vector<ObjectResult>& objec
     md << "![" << o.name << ": grab-box SDF slice](" << o.slicePng << ")\n\n";
     html << "<h2>" << escape(o.name) << "</h2>\n<p>" << escape(o.origin) << ", " << o.triangles
          << " triangles.</p>\n<p><img src=\"" << o.graspPng << "\" alt=\"" << escape(o.name)
-         << ": physics-convex, paper, ours\"></p>\n<p><img src=\"" << o.slicePng
+         << ": physics-convex, paper, ours\">\n<span class=\"caption\">left to right: "
+         << "<code>physics-convex</code>, <code>paper</code>, <code>ours</code></span></p>\n"
+         << "<p><img src=\"" << o.slicePng
          << "\" alt=\"grab-box SDF slice\" class=\"slice\"></p>\n<ul>\n";
     for (const auto& s : o.strategies) {
       md << "- " << summaryLine(s) << "\n";

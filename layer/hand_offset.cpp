@@ -31,6 +31,8 @@ void advanceHandOffset(SessionState& s, int h) {
   const HandGrasp& g = s.grasp->grasp(h == 0 ? Hand::left : Hand::right);
   const bool held = g.holding && g.solves > 0;
   if (held) {
+    // Nothing shown yet: the new grasp's correction is taken whole, the blend brings it in.
+    if (o.blend <= 0.0f) o.current = g.result.handCorrection;
     o.solved = g.result.handCorrection;
     o.openClearance = std::isfinite(g.result.openClearance) ? g.result.openClearance : 0.0f;
     o.displacement = g.result.handMoved;
@@ -44,6 +46,10 @@ void advanceHandOffset(SessionState& s, int h) {
   const float step =
       s.offsets.blendTime > 0.0f ? float(std::min(dt, 0.25) / s.offsets.blendTime) : 1.0f;
   o.blend = std::clamp(o.blend + (held ? step : -step), 0.0f, 1.0f);
+  const float follow = std::min(step, 1.0f);
+  o.current.position = glm::mix(o.current.position, o.solved.position, follow);
+  o.current.orientation =
+      glm::normalize(glm::slerp(o.current.orientation, o.solved.orientation, follow));
 }
 
 Pose shownHandOffset(const HandOffset& o) {
@@ -51,9 +57,9 @@ Pose shownHandOffset(const HandOffset& o) {
   // Smoothstep: the hand starts and ends its move at rest.
   const float w = o.blend * o.blend * (3.0f - 2.0f * o.blend);
   Pose p;
-  p.position = o.solved.position * w;
+  p.position = o.current.position * w;
   p.orientation =
-      glm::normalize(glm::slerp(glm::quat(1.0f, 0.0f, 0.0f, 0.0f), o.solved.orientation, w));
+      glm::normalize(glm::slerp(glm::quat(1.0f, 0.0f, 0.0f, 0.0f), o.current.orientation, w));
   return p;
 }
 

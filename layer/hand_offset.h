@@ -18,8 +18,11 @@ struct SessionState;
 
 // One hand's offset: what is shown and toward what it blends.
 struct HandOffset {
-  Pose solved;         // the held grasp's correction; after the release, the last one
-  float blend = 0.0f;  // 0..1: how much of `solved` is shown
+  Pose solved;  // the held grasp's correction; after the release, the last one
+  // What a full blend shows: follows `solved` over the blend time when a held grasp is solved
+  // again (the target moved relative to the hand), so a new correction never pops either.
+  Pose current;
+  float blend = 0.0f;  // 0..1: how much of `current` is shown
   XrTime last = 0;     // the predicted time of the last advance (0: none yet)
   float openClearance = 0.0f;
   float displacement = 0.0f;

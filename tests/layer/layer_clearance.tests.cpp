@@ -171,3 +171,55 @@ TEST_CASE("A palm squeezed through the thin plate is moved out before the finger
   const glm::vec3 c = hand.palm + hand.down * (0.015f - 0.004f);
   grabFromInside(toTestMesh(sdfg::makeThinPlate()), {{q.x, q.y, q.z, q.w}, {c.x, c.y, c.z}}, grip);
 }
+
+TEST_CASE("A tracked hand squeezed through the thin plate is moved out whole, never curled further",
+          "[layer][grasp][clearance]") {
+  // The mock runtime's tracked hand is flat and open (the user's curl 0), its wrist at the grip.
+  const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+  XrEnv env;
+  env.script =
+      gripLine(0, "right", grip) + squeezeLine(0, "right", 0.0f) + squeezeLine(6, "right", 1.0f);
+  applyEnv(env);
+  App app({{XR_EXT_HAND_TRACKING_EXTENSION_NAME, XR_SDFG_AUTO_GRASP_EXTENSION_NAME}});
+  REQUIRE(app.ok());
+  Ext ext(app);
+  XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
+  app.frames(2);
+  Reading before;
+  read(app, ext, tracker, before);
+  // The plate through the tracked palm, parallel to it, 4 mm above the palm's lowest point.
+  const XrHandJointLocationEXT& palm = before.joints.joints[XR_HAND_JOINT_PALM_EXT];
+  const sdfg::Pose palmPose = toPose(palm.pose);
+  const glm::vec3 down = palmPose.transformVector(glm::vec3(0, -1, 0));
+  const glm::vec3 y = -down;
+  const glm::vec3 x = glm::normalize(palmPose.transformVector(glm::vec3(1, 0, 0)));
+  const glm::quat q = glm::quat_cast(glm::mat3(x, y, glm::cross(x, y)));
+  const glm::vec3 c = palmPose.position + down * (palm.radius - 0.004f);
+  const TestMesh plate = toTestMesh(sdfg::makeThinPlate());
+  const XrPosef pose{{q.x, q.y, q.z, q.w}, {c.x, c.y, c.z}};
+  makeTarget(app, ext, plate, pose);
+  const ExactDistance exact(plate, pose);
+  const auto distance = [&](const XrVector3f& p) { return exact(p); };
+  REQUIRE(wholeHandClearance(before.joints, distance) < -0.003f);
+
+  Reading r;
+  for (int i = 0; i < 300; ++i) {
+    app.frame();
+    read(app, ext, tracker, r);
+    if (r.state.isGrasping && r.offset.blend >= 1.0f) break;
+  }
+  REQUIRE(r.state.isGrasping == XR_TRUE);
+  REQUIRE(r.offset.blend == 1.0f);
+  CHECK(r.offset.displacement > 0.003f);
+  CHECK(wholeHandClearance(r.joints, distance) > -5e-4f);
+  // Every joint is the user's own moved by the reported offset in the wrist frame: the open
+  // fingers are not curled (the user's curl is 0), only the whole hand moved.
+  const sdfg::Pose wrist = toPose(before.joints.joints[XR_HAND_JOINT_WRIST_EXT].pose);
+  const sdfg::Pose move = wrist * toPose(r.offset.offset) * wrist.inverse();
+  for (int j = 0; j < XR_HAND_JOINT_COUNT_EXT; ++j) {
+    CAPTURE(j);
+    const glm::vec3 expected = move.transformPoint(toPose(before.joints.joints[j].pose).position);
+    CHECK(glm::length(toPose(r.joints.joints[j].pose).position - expected) < 1e-4f);
+  }
+  CHECK(validationLog().empty());
+}

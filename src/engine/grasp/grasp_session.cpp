@@ -200,10 +200,22 @@ Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Targ
   return solveWithGrid(hand, objectFromHand, target.version, false, target.distance.get());
 }
 
+void GraspSession::noteTrackedParts(HandState& hand, const HandFrame& frame) {
+  hand.trackedPartCount = 0;
+  if (!frame.valid || frame.trackedJoints == nullptr || frame.trackedRadii == nullptr) return;
+  const Pose wristFromWorld = frame.worldFromWrist.inverse();
+  JointPoses local;
+  for (int j = 0; j < kJointCount; ++j)
+    local[size_t(j)] = wristFromWorld * (*frame.trackedJoints)[size_t(j)];
+  hand.trackedPartCount = jointParts(local, *frame.trackedRadii, hand.trackedParts);
+}
+
 Status GraspSession::solveWithGrid(HandState& hand, const Pose& objectFromHand, uint64_t version,
                                    bool gpu, const MeshDistance* exactMesh) {
   GraspScene scene;
   scene.field = &hand.grid;
+  scene.extraParts =
+      std::span<const HandPart>(hand.trackedParts.data(), size_t(hand.trackedPartCount));
   scene.objectFromHand = objectFromHand;
   std::optional<MeshExactSource> exact;
   if (settings_.exactCheck && exactMesh != nullptr) {
@@ -280,6 +292,7 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
             settings_.turnTolerance;
     if (hand.grasp.solves > 0 && !moved && hand.solvedVersion == it->second.version)
       return collected;
+    noteTrackedParts(hand, frame);
     const Status s = solve(hand, slot, it->first, it->second, objectFromHand);
     if (s != Status::ok) {
       cancelPending(hand, slot);
@@ -307,6 +320,7 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   hand.grasp = HandGrasp{};
   hand.grasp.holding = true;
   hand.grasp.target = *id;
+  noteTrackedParts(hand, frame);
   const Status s =
       solve(hand, slot, *id, target, located->worldFromObject.inverse() * frame.worldFromWrist);
   if (s != Status::ok) {

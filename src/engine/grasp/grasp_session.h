@@ -25,6 +25,7 @@
 #include <string>
 
 #include "base/status.h"
+#include "grasp/hand_clearance.h"
 #include "grasp/solver.h"
 #include "hand/hand_model.h"
 #include "mesh/mesh.h"
@@ -160,7 +161,13 @@ class GraspSession {
     bool pending = false;
     Pose pendingPose;
     uint64_t pendingVersion = 0;
+    // A tracked hand's open-hand parts as the user holds it (wrist frame), cleared besides the
+    // model's open hand (GraspScene::extraParts); 0 for a controller-driven hand.
+    HandParts trackedParts{};
+    int trackedPartCount = 0;
   };
+  // Sets hand.trackedParts from the frame's tracked joints (none: count 0). Before a solve.
+  static void noteTrackedParts(HandState& hand, const HandFrame& frame);
 
   Status solve(HandState& hand, size_t slot, uint64_t id, const Target& target,
                const Pose& objectFromHand);

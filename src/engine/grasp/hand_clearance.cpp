@@ -268,18 +268,25 @@ Candidate march(std::span<const HandPart> parts, const Pose& start, Measure& mea
 int handParts(const HandModel& hand, const FingerCurls& curls, HandParts& out) {
   JointPoses joints{};
   hand.pose(curls, joints);
-  int n = 0;
+  std::array<float, kJointCount> radii{};
+  for (int j = 0; j < kJointCount; ++j) radii[size_t(j)] = hand.jointRadius(Joint(j));
+  return jointParts(joints, radii, out, 0);
+}
+
+int jointParts(std::span<const Pose, kJointCount> joints, std::span<const float, kJointCount> radii,
+               HandParts& out, int first) {
+  int n = std::max(0, first);
   auto add = [&](const glm::vec3& c, float r, float cover, Joint j) {
     if (n >= kMaxHandParts) return;
     out[n++] = HandPart{c, r, cover, j};
   };
-  add(joints[size_t(Joint::palm)].position, hand.jointRadius(Joint::palm),
-      hand.jointRadius(Joint::palm), Joint::palm);
+  const float palmRadius = radii[size_t(Joint::palm)];
+  add(joints[size_t(Joint::palm)].position, palmRadius, palmRadius, Joint::palm);
   for (int f = 0; f < kFingerCount; ++f) {
     const std::span<const Joint> fj = fingerJoints(Finger(f));
     for (size_t b = 0; b + 1 < fj.size(); ++b) {
       const glm::vec3 p0 = joints[size_t(fj[b])].position, p1 = joints[size_t(fj[b + 1])].position;
-      const float r0 = hand.jointRadius(fj[b]), r1 = hand.jointRadius(fj[b + 1]);
+      const float r0 = radii[size_t(fj[b])], r1 = radii[size_t(fj[b + 1])];
       const float rmin = std::max(1e-4f, std::min(r0, r1));
       const float length = glm::length(p1 - p0);
       const int count = std::max(1, int(std::ceil(length / (kPartSpacing * rmin))));

@@ -37,14 +37,20 @@ struct HandPart {
   Joint joint = Joint::palm;  // the joint the part's bone starts at (the palm: its own sphere)
 };
 
-// Most parts handParts() writes: the palm and five fingers' capsules, metacarpal to tip.
-inline constexpr int kMaxHandParts = 192;
+// Most parts clearHand() takes: two hands' worth of jointParts() (the model's open hand and a
+// tracked hand's own pose), each the palm and five fingers' capsules, metacarpal to tip.
+inline constexpr int kMaxHandParts = 384;
 using HandParts = std::array<HandPart, kMaxHandParts>;
 
 // The parts of the hand at the given curls, hand space: the palm joint's sphere, then per finger
 // spheres along every bone from the metacarpal joint to the tip, no more than 0.7 of the smaller
 // joint radius apart. Writes at most kMaxHandParts parts to `out` and returns how many.
 int handParts(const HandModel& hand, const FingerCurls& curls, HandParts& out);
+
+// The same parts for any 26 joints (hand space) and their radii: a tracked hand as the user holds
+// it. Writes from out[first] on, at most up to kMaxHandParts, and returns the new count.
+int jointParts(std::span<const Pose, kJointCount> joints, std::span<const float, kJointCount> radii,
+               HandParts& out, int first = 0);
 
 struct ClearanceOptions {
   float margin = 0.0005f;       // clearance every part ends with, metres (>= 0)

@@ -28,6 +28,7 @@ namespace sdfg {
 
 class PhysicsCollider;  // solver_physics.h
 class MeshDistance;     // mesh_distance.h
+struct HandPart;        // hand_clearance.h
 
 struct SolverOptions {
   float da = 0.1f;           // curl step along each finger's curve, in (0, 1]
@@ -127,6 +128,10 @@ struct GraspScene {
   // Optional exact distance of the same target (scene hand frame). "ours" checks and corrects
   // its stops with it; null: the field alone, as before. Other strategies ignore it.
   const ExactDistanceSource* exact = nullptr;
+  // More parts of the open hand to clear before closing (SolverOptions::clearance), hand space of
+  // the scene: a tracked hand as the user holds it, which can differ from the model's open pose
+  // by centimetres. Empty: the model's open hand alone. The caller owns the parts.
+  std::span<const HandPart> extraParts{};
 };
 
 class GraspSolver {

@@ -241,7 +241,15 @@ Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {
     co.margin = options_.clearanceMargin;
     co.maxCorrection = options_.clearanceBound;
     co.rotation = options_.clearanceRotation;
-    const std::span<const HandPart> parts(parts_.data(), size_t(partCount_));
+    // The model's open hand (where the fingers close from), and the scene's own parts of the
+    // hand (a tracked hand as the user holds it), cleared together.
+    HandParts all;
+    int count = 0;
+    for (int i = 0; i < partCount_ && count < kMaxHandParts; ++i) all[size_t(count++)] = parts_[i];
+    for (const HandPart& p : scene.extraParts) {
+      if (count < kMaxHandParts) all[size_t(count++)] = p;
+    }
+    const std::span<const HandPart> parts(all.data(), size_t(count));
     Result<ClearanceResult> c =
         clearHand(parts, palm_, &field, scene.exact, co, out.handCorrection);
     if (c.ok() && c->exceeded && approached) {

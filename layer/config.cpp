@@ -90,7 +90,8 @@ bool applyConfigValue(Config& config, const std::string& key, const std::string&
   } else if (key == "offset_blend_time") {
     ok = parseFloat(value, 0.0f, 2.0f, c.offsetBlendTime);
   } else if (key == "test_gpu_fault") {
-    ok = value == "none" || value == "lost_at_submit" || value == "lost_at_poll";
+    ok = value == "none" || value == "lost_at_submit" || value == "lost_at_poll" ||
+         value == "never_ready";
     c.testGpuFault = value;
   } else {
     ok = false;

@@ -30,7 +30,8 @@ struct Config {
   enum class Gpu { automatic, on, off };
   Gpu gpu = Gpu::automatic;
   bool extraQueue = true;  // extra_queue: add a queue to Vulkan2 apps' devices when one is spare
-  // test_gpu_fault: none, lost_at_submit, lost_at_poll (tests only: a simulated device loss)
+  // test_gpu_fault: none, lost_at_submit, lost_at_poll (tests only: a simulated device loss),
+  // never_ready (the GPU path never finishes preparing, as if the driver compiled forever)
   std::string testGpuFault = "none";
   std::string configPath;  // the file that was read, empty when none
   // Never inside (docs/layer.md, "The hand's clearance"): clear_hand, clear_bound (metres),

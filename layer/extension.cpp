@@ -19,10 +19,15 @@ namespace {
   if (!(cond)) return logError(result, cmd, __VA_ARGS__)
 #define SDFG_VERIFY_NOT_NULL(cmd, arg) \
   SDFG_VERIFY(cmd, (arg) != nullptr, XR_ERROR_VALIDATION_FAILURE, "(" #arg ") is null")
-#define SDFG_VERIFY_TYPE(cmd, arg, expected)                               \
-  SDFG_VERIFY_NOT_NULL(cmd, arg);                                          \
-  SDFG_VERIFY(cmd, (arg)->type == (expected), XR_ERROR_VALIDATION_FAILURE, \
-              "(" #arg "->type) is %d, expected " #expected, int((arg)->type))
+// `type` is compared as an integer: an out-of-range value must not be loaded as an enum.
+#define SDFG_VERIFY_TYPE(cmd, arg, expected)                                               \
+  SDFG_VERIFY_NOT_NULL(cmd, arg);                                                          \
+  SDFG_VERIFY(cmd, rawEnum((arg)->type) == int32_t(expected), XR_ERROR_VALIDATION_FAILURE, \
+              "(" #arg "->type) is %d, expected " #expected, int(rawEnum((arg)->type)))
+// A `next` chain is walked only when it ends within kMaxChainLength structs.
+#define SDFG_VERIFY_CHAIN(cmd, chain)                                    \
+  SDFG_VERIFY(cmd, chainLength(chain) >= 0, XR_ERROR_VALIDATION_FAILURE, \
+              "(" #chain ") has more than %zu structs: a cycle, or not a chain", kMaxChainLength)
 
 std::shared_ptr<SessionState> findSession(XrSession session) {
   return sessions().find(key(session));
@@ -40,6 +45,7 @@ std::pair<std::shared_ptr<TargetState>, std::shared_ptr<SessionState>> findTarge
 XrResult verifyPlacement(const char* cmd, const SessionState& s,
                          const XrGraspTargetPlacementSDFG* placement) {
   SDFG_VERIFY_TYPE(cmd, placement, XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG);
+  SDFG_VERIFY_CHAIN(cmd, placement->next);
   SDFG_VERIFY(cmd, placement->space != XR_NULL_HANDLE, XR_ERROR_HANDLE_INVALID,
               "(placement->space) is XR_NULL_HANDLE");
   SDFG_VERIFY(cmd, s.spaces.count(key(placement->space)) != 0, XR_ERROR_HANDLE_INVALID,
@@ -107,10 +113,11 @@ XrResult verifyBuffers(const char* cmd, const XrGraspTargetVulkanBuffersSDFG* b,
   SDFG_VERIFY(cmd, b->vertexOffset % 4 == 0, XR_ERROR_VALIDATION_FAILURE,
               "(vertexOffset) is %llu, must be a multiple of 4",
               (unsigned long long)b->vertexOffset);
-  SDFG_VERIFY(cmd, b->indexType == VK_INDEX_TYPE_UINT16 || b->indexType == VK_INDEX_TYPE_UINT32,
+  const int32_t indexType = rawEnum(b->indexType);
+  SDFG_VERIFY(cmd, indexType == VK_INDEX_TYPE_UINT16 || indexType == VK_INDEX_TYPE_UINT32,
               XR_ERROR_VALIDATION_FAILURE, "(indexType) is %d, must be UINT16 or UINT32",
-              int(b->indexType));
-  const VkDeviceSize indexSize = b->indexType == VK_INDEX_TYPE_UINT16 ? 2 : 4;
+              int(indexType));
+  const VkDeviceSize indexSize = indexType == VK_INDEX_TYPE_UINT16 ? 2 : 4;
   SDFG_VERIFY(cmd, b->indexOffset % indexSize == 0, XR_ERROR_VALIDATION_FAILURE,
               "(indexOffset) is %llu, must be a multiple of the index size",
               (unsigned long long)b->indexOffset);
@@ -191,13 +198,18 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
   SDFG_VERIFY(cmd, s != nullptr, XR_ERROR_HANDLE_INVALID, "(session) is not valid");
   SDFG_VERIFY_TYPE(cmd, createInfo, XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG);
   SDFG_VERIFY_NOT_NULL(cmd, target);
+  SDFG_VERIFY_CHAIN(cmd, createInfo->next);
+  SDFG_VERIFY(cmd,
+              countInChain(createInfo->next, XR_TYPE_GRASP_TARGET_VERTICES_SDFG) +
+                      countInChain(createInfo->next, XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG) ==
+                  1,
+              XR_ERROR_VALIDATION_FAILURE,
+              "(createInfo->next) must chain exactly one XrGraspTargetVerticesSDFG or "
+              "XrGraspTargetVulkanBuffersSDFG");
   const auto* arrays = findInChain<const XrGraspTargetVerticesSDFG>(
       createInfo->next, XR_TYPE_GRASP_TARGET_VERTICES_SDFG);
   const auto* buffers = findInChain<const XrGraspTargetVulkanBuffersSDFG>(
       createInfo->next, XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG);
-  SDFG_VERIFY(cmd, (arrays != nullptr) != (buffers != nullptr), XR_ERROR_VALIDATION_FAILURE,
-              "(createInfo->next) must chain exactly one XrGraspTargetVerticesSDFG or "
-              "XrGraspTargetVulkanBuffersSDFG");
   std::lock_guard lock(s->mutex);
   SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
   if (XrResult r = verifyPlacement(cmd, *s, &createInfo->placement); r != XR_SUCCESS) return r;
@@ -263,7 +275,9 @@ XrResult XRAPI_CALL SdfgXrUpdateGraspTargetVerticesSDFG(XrGraspTargetSDFG target
   SDFG_VERIFY(cmd, t != nullptr, XR_ERROR_HANDLE_INVALID, "(target) is not valid");
   SDFG_VERIFY_NOT_NULL(cmd, vertices);
   const auto* base = static_cast<const XrBaseInStructure*>(vertices);
-  if (base->type == XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG) {
+  SDFG_VERIFY_CHAIN(cmd, base->next);
+  const int32_t type = rawEnum(base->type);
+  if (type == XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG) {
     const auto* b = static_cast<const XrGraspTargetVulkanBuffersSDFG*>(vertices);
     SDFG_VERIFY(cmd, t->deviceBuffers, XR_ERROR_VALIDATION_FAILURE,
                 "(vertices) are Vulkan buffers; the target was created from arrays");
@@ -283,9 +297,8 @@ XrResult XRAPI_CALL SdfgXrUpdateGraspTargetVerticesSDFG(XrGraspTargetSDFG target
     return logError(XR_ERROR_FEATURE_UNSUPPORTED, cmd, "no Vulkan backend in this build");
 #endif
   }
-  SDFG_VERIFY(cmd, base->type == XR_TYPE_GRASP_TARGET_VERTICES_SDFG, XR_ERROR_VALIDATION_FAILURE,
-              "(vertices->type) is %d, expected XR_TYPE_GRASP_TARGET_VERTICES_SDFG",
-              int(base->type));
+  SDFG_VERIFY(cmd, type == XR_TYPE_GRASP_TARGET_VERTICES_SDFG, XR_ERROR_VALIDATION_FAILURE,
+              "(vertices->type) is %d, expected XR_TYPE_GRASP_TARGET_VERTICES_SDFG", int(type));
   SDFG_VERIFY(cmd, !t->deviceBuffers, XR_ERROR_VALIDATION_FAILURE,
               "(vertices) are arrays; the target was created from Vulkan buffers");
   const auto* v = static_cast<const XrGraspTargetVerticesSDFG*>(vertices);
@@ -322,9 +335,12 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
   SDFG_VERIFY(cmd, s != nullptr, XR_ERROR_HANDLE_INVALID, "(session) is not valid");
   SDFG_VERIFY_TYPE(cmd, getInfo, XR_TYPE_GRASP_STATE_GET_INFO_SDFG);
   SDFG_VERIFY_TYPE(cmd, state, XR_TYPE_GRASP_STATE_SDFG);
-  SDFG_VERIFY(cmd, getInfo->hand == XR_HAND_LEFT_EXT || getInfo->hand == XR_HAND_RIGHT_EXT,
-              XR_ERROR_VALIDATION_FAILURE, "(getInfo->hand) is %d", int(getInfo->hand));
-  const Hand hand = getInfo->hand == XR_HAND_LEFT_EXT ? Hand::left : Hand::right;
+  SDFG_VERIFY_CHAIN(cmd, getInfo->next);
+  SDFG_VERIFY_CHAIN(cmd, state->next);
+  const int32_t handValue = rawEnum(getInfo->hand);
+  SDFG_VERIFY(cmd, handValue == XR_HAND_LEFT_EXT || handValue == XR_HAND_RIGHT_EXT,
+              XR_ERROR_VALIDATION_FAILURE, "(getInfo->hand) is %d", int(handValue));
+  const Hand hand = handValue == XR_HAND_LEFT_EXT ? Hand::left : Hand::right;
   std::lock_guard lock(s->mutex);
   SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
   const HandGrasp& g = s->grasp->grasp(hand);
@@ -349,8 +365,8 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
     info->graspBackend = !held          ? XR_GRASP_SDF_BACKEND_NONE_SDFG
                          : g.builtOnGpu ? XR_GRASP_SDF_BACKEND_VULKAN_SDFG
                                         : XR_GRASP_SDF_BACKEND_CPU_SDFG;
-    info->sessionBackend = s->grasp->deferredUsable() ? XR_GRASP_SDF_BACKEND_VULKAN_SDFG
-                                                      : XR_GRASP_SDF_BACKEND_CPU_SDFG;
+    info->sessionBackend = s->grasp->deferredReady() ? XR_GRASP_SDF_BACKEND_VULKAN_SDFG
+                                                     : XR_GRASP_SDF_BACKEND_CPU_SDFG;
     info->gpuBuildCount = st.gpuBuilds;
     info->cpuBuildCount = st.cpuBuilds;
     info->gpuFailed = st.gpuFailed ? XR_TRUE : XR_FALSE;
@@ -368,10 +384,11 @@ XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession session,
   auto s = findSession(session);
   SDFG_VERIFY(cmd, s != nullptr, XR_ERROR_HANDLE_INVALID, "(session) is not valid");
   SDFG_VERIFY_TYPE(cmd, options, XR_TYPE_GRASP_OPTIONS_SDFG);
+  SDFG_VERIFY_CHAIN(cmd, options->next);
   const XrGraspOptionsSDFG& o = *options;
-  SDFG_VERIFY(cmd,
-              o.solver >= XR_GRASP_SOLVER_DEFAULT_SDFG && o.solver <= XR_GRASP_SOLVER_OURS_SDFG,
-              XR_ERROR_VALIDATION_FAILURE, "(options->solver) is %d", int(o.solver));
+  const int32_t solver = rawEnum(o.solver);
+  SDFG_VERIFY(cmd, solver >= XR_GRASP_SOLVER_DEFAULT_SDFG && solver <= XR_GRASP_SOLVER_OURS_SDFG,
+              XR_ERROR_VALIDATION_FAILURE, "(options->solver) is %d", int(solver));
   SDFG_VERIFY(cmd, o.tipRadius == 0.0f || (o.tipRadius > 0.0f && o.tipRadius <= 0.05f),
               XR_ERROR_VALIDATION_FAILURE, "(options->tipRadius) must be 0 or in (0, 0.05]");
   const bool boxZero = o.boxSize.x == 0.0f && o.boxSize.y == 0.0f && o.boxSize.z == 0.0f;
@@ -390,8 +407,8 @@ XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession session,
                   (o.resolution >= kMinGridResolution && o.resolution <= kMaxGridResolution),
               XR_ERROR_VALIDATION_FAILURE, "(options->resolution) is %u, must be 0 or 2..128",
               o.resolution);
-  SDFG_VERIFY(cmd, o.curlStep == 0.0f || (o.curlStep >= 1e-5f && o.curlStep <= 1.0f),
-              XR_ERROR_VALIDATION_FAILURE, "(options->curlStep) must be 0 or in [1e-5, 1]");
+  SDFG_VERIFY(cmd, o.curlStep == 0.0f || (o.curlStep > 1e-5f && o.curlStep <= 1.0f),
+              XR_ERROR_VALIDATION_FAILURE, "(options->curlStep) must be 0 or in (1e-5, 1]");
   SDFG_VERIFY(cmd, o.grabThreshold == 0.0f || (o.grabThreshold > 0.0f && o.grabThreshold <= 1.0f),
               XR_ERROR_VALIDATION_FAILURE, "(options->grabThreshold) must be 0 or in (0, 1]");
   ClearanceRequest clearance;
@@ -400,8 +417,8 @@ XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession session,
   std::lock_guard lock(s->mutex);
   SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
   GraspSettings settings = settingsFromConfig(s->instance->config);
-  if (o.solver == XR_GRASP_SOLVER_PAPER_SDFG) settings.solver = "paper";
-  if (o.solver == XR_GRASP_SOLVER_OURS_SDFG) settings.solver = "ours";
+  if (solver == XR_GRASP_SOLVER_PAPER_SDFG) settings.solver = "paper";
+  if (solver == XR_GRASP_SOLVER_OURS_SDFG) settings.solver = "ours";
   if (o.tipRadius > 0.0f) settings.solverOptions.threshold = o.tipRadius;
   if (!boxZero) {
     settings.box.handFromBox = toPose(o.boxPose);
@@ -413,7 +430,7 @@ XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession session,
   float blendTime = s->instance->config.offsetBlendTime;
   clearance.apply(settings, blendTime);
   if (Status st = s->grasp->configure(settings); st != Status::ok)
-    return logError(st == Status::invalid_argument && o.solver == XR_GRASP_SOLVER_OURS_SDFG
+    return logError(st == Status::invalid_argument && solver == XR_GRASP_SOLVER_OURS_SDFG
                         ? XR_ERROR_FEATURE_UNSUPPORTED
                         : toXrResult(st),
                     cmd, "the options were refused (%s; solver '%s')", toString(st),

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <atomic>
+#include <cstring>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -201,13 +202,52 @@ XrPosef toXr(const Pose& p);
 bool isUnitQuaternion(const XrQuaternionf& q);
 bool isFinitePose(const XrPosef& p);
 
-// Finds a struct of `type` in a `next` chain.
+// The 32-bit value of an enum field in the app's memory, read as an integer. Loading an enum
+// object that holds a value outside its type's range (hand = -1) is undefined behaviour, and an
+// out-of-range value is exactly what the checks look for: they compare this instead.
+template <class E>
+int32_t rawEnum(const E& field) {
+  static_assert(std::is_enum_v<E> && sizeof(E) == sizeof(int32_t));
+  int32_t value;
+  std::memcpy(&value, &field, sizeof value);
+  return value;
+}
+
+// The longest `next` chain the layer walks. Real chains hold a handful of structs; a longer one
+// is a cycle (a struct whose `next` points back into the chain) or garbage, and following it
+// would hang the app's thread.
+inline constexpr size_t kMaxChainLength = 32;
+
+// The number of structs on `chain`, or -1 when it has more than kMaxChainLength (a cycle or an
+// absurd length; the extension answers XR_ERROR_VALIDATION_FAILURE).
+inline int chainLength(const void* chain) {
+  int n = 0;
+  for (auto* p = static_cast<const XrBaseInStructure*>(chain); p != nullptr; p = p->next) {
+    if (++n > int(kMaxChainLength)) return -1;
+  }
+  return n;
+}
+
+// How many structs of `type` a chain holds (at most kMaxChainLength are looked at).
+inline int countInChain(const void* chain, XrStructureType type) {
+  int n = 0;
+  size_t walked = 0;
+  for (auto* p = static_cast<const XrBaseInStructure*>(chain);
+       p != nullptr && walked < kMaxChainLength; p = p->next, ++walked) {
+    if (rawEnum(p->type) == int32_t(type)) ++n;
+  }
+  return n;
+}
+
+// Finds a struct of `type` in a `next` chain, looking at kMaxChainLength structs at most, so a
+// cyclic chain cannot hang the call (beyond that the struct counts as absent).
 template <class T, class Base>
 T* findInChain(Base* chain, XrStructureType type) {
+  size_t walked = 0;
   for (auto* p = reinterpret_cast<XrBaseOutStructure*>(
            const_cast<void*>(static_cast<const void*>(chain)));
-       p != nullptr; p = p->next) {
-    if (p->type == type) return reinterpret_cast<T*>(p);
+       p != nullptr && walked < kMaxChainLength; p = p->next, ++walked) {
+    if (rawEnum(p->type) == int32_t(type)) return reinterpret_cast<T*>(p);
   }
   return nullptr;
 }

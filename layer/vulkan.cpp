@@ -55,6 +55,7 @@ PFN_vkGetInstanceProcAddr appGetInstanceProcAddr(InstanceState& inst, VkInstance
 VkGraspFault faultFromConfig(const std::string& name) {
   if (name == "lost_at_submit") return VkGraspFault::lostAtSubmit;
   if (name == "lost_at_poll") return VkGraspFault::lostAtPoll;
+  if (name == "never_ready") return VkGraspFault::neverReady;
   return VkGraspFault::none;
 }
 #endif
@@ -97,6 +98,10 @@ std::unique_ptr<DeferredSdfBackend> makeVulkanBackend(SessionState& s) {
   }
   VkGraspBackendOptions options;
   options.log = [](const std::string& line) { SDFG_LOG_WARN("sdfg vulkan", "%s", line.c_str()); };
+  // Pipelines are made on the backend's own thread and warmed up by small builds in the first
+  // frames: neither this xrCreateSession nor the user's first grab waits for the driver's
+  // compiler (seconds on lavapipe with a cold shader cache). Grabs before then use the CPU.
+  options.prepareInBackground = true;
   auto backend = VkGraspBackend::create(app, own ? &*own : nullptr, options);
   if (!backend) {
     SDFG_LOG_WARN(cmd, "Vulkan SDF backend unavailable, grab-box SDFs on the CPU: %s",

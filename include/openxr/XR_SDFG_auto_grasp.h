@@ -15,10 +15,23 @@
 // enum values lie in 1009900000..1009900999 (1000000000 + (9901 - 1) * 1000 + n), a range no
 // registered extension uses (registered numbers are below 1000 as of OpenXR 1.1.62).
 //
-// Errors every function returns besides XR_SUCCESS: XR_ERROR_HANDLE_INVALID (a null, destroyed
-// or foreign handle), XR_ERROR_VALIDATION_FAILURE (a null pointer, a wrong `type`, a bad enum or
-// an out-of-range number), XR_ERROR_RUNTIME_FAILURE (a failure inside the layer). A function that
-// fails changes nothing.
+// Errors and rules. Every function returns XR_SUCCESS or one of the codes below, and a function
+// that fails changes nothing (no target is made or removed, no option or placement changes, no
+// output is written). Rules that hold for every function:
+// - XR_ERROR_HANDLE_INVALID: a session or target handle that is XR_NULL_HANDLE, destroyed,
+//   of another kind (an XrSpace passed as an XrSession) or not made through this layer; an
+//   XrSpace that is null, destroyed or not a reference or action space of the target's session.
+// - XR_ERROR_VALIDATION_FAILURE: a null pointer argument; a `type` that is not the one named on
+//   the struct; an enum field outside its listed values (checked as a 32-bit integer, so any bit
+//   pattern is safe); a float that is NaN or infinite; a number outside its documented range; a
+//   `next` chain longer than 32 structs (a cycle, such as a struct whose `next` points to
+//   itself, counts as too long: it is refused, never followed forever).
+// - XR_ERROR_POSE_INVALID: a pose whose orientation is not a unit quaternion (|q|^2 within 1e-3
+//   of 1); a finite pose is checked first (non-finite: XR_ERROR_VALIDATION_FAILURE).
+// - XR_ERROR_SESSION_LOST: the session is being destroyed on another thread.
+// - XR_ERROR_OUT_OF_MEMORY: the layer could not allocate what the call needs.
+// - XR_ERROR_RUNTIME_FAILURE: a failure inside the layer (logged).
+// Function-specific errors are listed at each function type below.
 #ifndef XR_SDFG_AUTO_GRASP_H_
 #define XR_SDFG_AUTO_GRASP_H_ 1
 
@@ -61,7 +74,11 @@ typedef struct XrGraspTargetPlacementSDFG {
 // Mesh as CPU arrays. The layer copies them; the app keeps ownership.
 // vertexCount: number of vertices (xyz float triples in `vertices`), 3..XR_MAX_..._VERTICES;
 // indexCount: number of uint32 indices, a multiple of 3, 3..XR_MAX_..._INDICES, each below
-// vertexCount. Every coordinate must be finite; no triangle may repeat a vertex.
+// vertexCount. Every coordinate must be finite. Every triangle must have a non-zero area: one
+// that repeats an index, whose corners coincide (two indices naming vertices at the same
+// position) or whose corners are collinear is refused. Each of these is
+// XR_ERROR_VALIDATION_FAILURE, on create and on update (new positions that collapse a triangle
+// are refused and the old ones stay).
 typedef struct XrGraspTargetVerticesSDFG {
   XrStructureType type;  // XR_TYPE_GRASP_TARGET_VERTICES_SDFG
   const void* XR_MAY_ALIAS next;
@@ -108,7 +125,8 @@ typedef struct XrGraspTargetVulkanBuffersSDFG {
 #endif
 
 // Chain exactly one mesh struct (XrGraspTargetVerticesSDFG or XrGraspTargetVulkanBuffersSDFG)
-// on `next`.
+// on `next`: none, two of one kind, or one of each is XR_ERROR_VALIDATION_FAILURE. Structs of
+// other types on the chain are ignored.
 typedef struct XrGraspTargetCreateInfoSDFG {
   XrStructureType type;  // XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG
   const void* XR_MAY_ALIAS next;
@@ -150,10 +168,13 @@ typedef enum XrGraspSdfBackendSDFG {
 typedef struct XrGraspBuildInfoSDFG {
   XrStructureType type;  // XR_TYPE_GRASP_BUILD_INFO_SDFG
   void* XR_MAY_ALIAS next;
-  XrGraspSdfBackendSDFG graspBackend;    // of the hand's shown grasp; NONE when not grasping
-  XrGraspSdfBackendSDFG sessionBackend;  // where the session's next build goes
-  uint64_t gpuBuildCount;                // builds of the session done on the GPU so far
-  uint64_t cpuBuildCount;                // and on the CPU
+  XrGraspSdfBackendSDFG graspBackend;  // of the hand's shown grasp; NONE when not grasping
+  // Where the session's next build goes: VULKAN once its GPU path is ready (pipelines are made
+  // and warmed up in the session's first frames, off the app's calls), CPU before that (a grab
+  // then is built on the CPU at once; one of a Vulkan-buffer target waits) and after a failure.
+  XrGraspSdfBackendSDFG sessionBackend;
+  uint64_t gpuBuildCount;  // builds of the session done on the GPU so far
+  uint64_t cpuBuildCount;  // and on the CPU
   XrBool32 gpuFailed;  // the GPU path failed (device lost or any Vulkan error): CPU from then on
   uint32_t pendingGpuBuilds;  // GPU builds requested and not yet collected (0..2)
 } XrGraspBuildInfoSDFG;
@@ -176,26 +197,51 @@ typedef struct XrGraspOptionsSDFG {
                         // boxSize is zero)
   XrVector3f boxSize;   // edge lengths x y z in metres, each in (0, 1]; all zero = default
   uint32_t resolution;  // nodes per axis, 0 or 2..128
-  float curlStep;       // curl step along each finger's curve, 0 or (1e-5, 1]
+  float curlStep;       // curl step along each finger's curve, 0 or (1e-5, 1] (1e-5 excluded)
   float grabThreshold;  // squeeze that starts a grab, 0 or (0, 1]; release is 0.8 of it
 } XrGraspOptionsSDFG;
 
+// Registers a graspable mesh on `session`; writes `target` only on success.
+// Errors: HANDLE_INVALID (session; placement.space), VALIDATION_FAILURE (createInfo or target
+// null; a wrong `type` on createInfo, placement or the mesh struct; not exactly one mesh struct;
+// a chain too long; any rule of the mesh struct broken; a non-finite placement pose),
+// POSE_INVALID (placement orientation), GRAPHICS_DEVICE_INVALID and FEATURE_UNSUPPORTED (Vulkan
+// buffers, see XrGraspTargetVulkanBuffersSDFG), OUT_OF_MEMORY, SESSION_LOST, RUNTIME_FAILURE.
 typedef XrResult(XRAPI_PTR* PFN_xrCreateGraspTargetSDFG)(
     XrSession session, const XrGraspTargetCreateInfoSDFG* createInfo, XrGraspTargetSDFG* target);
+// Removes `target`; a hand holding it lets go. Errors: HANDLE_INVALID (null, destroyed, or its
+// session destroyed).
 typedef XrResult(XRAPI_PTR* PFN_xrDestroyGraspTargetSDFG)(XrGraspTargetSDFG target);
 // New vertex positions (same count, same topology): animated and skinned meshes. Pass an
-// XrGraspTargetVerticesSDFG with indexCount 0 (array targets), or an
+// XrGraspTargetVerticesSDFG with indexCount 0 and indices NULL (array targets), or an
 // XrGraspTargetVulkanBuffersSDFG (buffer targets: the app says its buffers changed; the
 // buffers, offsets, stride, index type and bounds may change, the counts may not). A held target
-// is solved again from the next xrSyncActions. The wrong kind for the target:
-// XR_ERROR_VALIDATION_FAILURE.
+// is solved again from the next xrSyncActions.
+// Errors: HANDLE_INVALID (target), VALIDATION_FAILURE (vertices null; its `type` neither mesh
+// struct; the wrong kind for the target; another vertex or index count; indexCount or indices
+// set on arrays; a non-finite coordinate; positions that give a triangle zero area; any rule of
+// XrGraspTargetVulkanBuffersSDFG broken; a chain too long), FEATURE_UNSUPPORTED (a buffer target
+// after the session's GPU path failed), SESSION_LOST, OUT_OF_MEMORY, RUNTIME_FAILURE.
 typedef XrResult(XRAPI_PTR* PFN_xrUpdateGraspTargetVerticesSDFG)(XrGraspTargetSDFG target,
                                                                  const void* vertices);
+// Moves `target` to another space of its session, or another pose. Errors: HANDLE_INVALID
+// (target; placement->space), VALIDATION_FAILURE (placement null, wrong `type`, non-finite pose,
+// a chain too long), POSE_INVALID (orientation), RUNTIME_FAILURE.
 typedef XrResult(XRAPI_PTR* PFN_xrSetGraspTargetPlacementSDFG)(
     XrGraspTargetSDFG target, const XrGraspTargetPlacementSDFG* placement);
+// Fills `state` (and an XrGraspBuildInfoSDFG chained on it) for one hand. Errors:
+// HANDLE_INVALID (session), VALIDATION_FAILURE (getInfo or state null or of the wrong `type`;
+// hand neither XR_HAND_LEFT_EXT nor XR_HAND_RIGHT_EXT; a chain too long on either),
+// SESSION_LOST, RUNTIME_FAILURE.
 typedef XrResult(XRAPI_PTR* PFN_xrGetGraspStateSDFG)(XrSession session,
                                                      const XrGraspStateGetInfoSDFG* getInfo,
                                                      XrGraspStateSDFG* state);
+// Sets the session's options, from the next grab. Errors: HANDLE_INVALID (session),
+// VALIDATION_FAILURE (options null or of the wrong `type`; solver not one of the listed values;
+// a field outside its range, NaN included; boxPose non-finite or farther than 1 m from the wrist
+// when boxSize is set; a chain too long), POSE_INVALID (boxPose orientation when boxSize is
+// set), FEATURE_UNSUPPORTED (XR_GRASP_SOLVER_OURS_SDFG in a build without it), SESSION_LOST,
+// OUT_OF_MEMORY, RUNTIME_FAILURE.
 typedef XrResult(XRAPI_PTR* PFN_xrSetGraspOptionsSDFG)(XrSession session,
                                                        const XrGraspOptionsSDFG* options);
 

@@ -172,3 +172,28 @@ TEST_CASE("The runtime ends the session after the number of frames it is asked f
         std::vector<XrSessionState>{XR_SESSION_STATE_IDLE, XR_SESSION_STATE_EXITING});
   CHECK(xr.validationMessages().empty());
 }
+
+TEST_CASE("The runtime never hands out a handle value twice, so a destroyed one stays invalid",
+          "[runtime][session]") {
+  // Without core validation: it would refuse the stale handle itself, and the point here is
+  // that the runtime does.
+  sdfg::test::InstanceOptions options;
+  options.coreValidation = false;
+  XrHarness xr(options);
+  REQUIRE(xr.createResult() == XR_SUCCESS);
+  auto getStats = xr.proc<PFN_xrMockRuntimeGetStatsSDFG>("xrMockRuntimeGetStatsSDFG");
+  REQUIRE(getStats != nullptr);
+  std::vector<XrSession> seen;
+  for (int i = 0; i < 8; ++i) {
+    const auto session = xr.createHeadlessSession();
+    REQUIRE(session);
+    for (XrSession old : seen) {
+      CHECK(*session != old);
+      // The destroyed session's handle names nothing, not the new session.
+      XrMockRuntimeStatsSDFG stats{};
+      CHECK(getStats(old, &stats) == XR_ERROR_HANDLE_INVALID);
+    }
+    seen.push_back(*session);
+    REQUIRE(xrDestroySession(*session) == XR_SUCCESS);
+  }
+}

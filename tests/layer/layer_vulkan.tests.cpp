@@ -5,6 +5,7 @@
 // That the SDF came from the GPU is read from the extension's XrGraspBuildInfoSDFG, not assumed.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -22,15 +23,15 @@ const char* graphicsName(Graphics g) {
   return g == Graphics::vulkan ? "XR_KHR_vulkan_enable" : "XR_KHR_vulkan_enable2";
 }
 
-// A right hand at `grip` that squeezes fully from frame 3. `gpu` is the layer's gpu key: these
-// tests ask for "on", because with "auto" a CPU device such as lavapipe builds array targets on
-// the CPU.
-XrEnv squeezeEnv(const XrPosef& grip, const char* gpu = "on") {
+// A right hand at `grip` that squeezes fully from frame 3 (`squeeze`), or holds open until the
+// test squeezes (squeezeWhenGpuReady). `gpu` is the layer's gpu key: these tests ask for "on",
+// because with "auto" a CPU device such as lavapipe builds array targets on the CPU.
+XrEnv squeezeEnv(const XrPosef& grip, const char* gpu = "on", bool squeeze = true) {
   XrEnv env;
   env.handTracking = "absent";
   env.extra = {{"SDFG_AUTOGRASP_GPU", gpu}};
-  env.script = gripLine(0, "right", grip) + squeezeLine(0, "right", 0.0f) +
-               squeezeLine(2, "right", 0.0f) + squeezeLine(3, "right", 1.0f);
+  env.script = gripLine(0, "right", grip) + squeezeLine(0, "right", 0.0f);
+  if (squeeze) env.script += squeezeLine(2, "right", 0.0f) + squeezeLine(3, "right", 1.0f);
   return env;
 }
 
@@ -48,16 +49,29 @@ State graspState(const App& app, const Ext& ext) {
 }
 
 // Runs frames until the hand shows a grasp (the GPU result arrives a frame or more after the
-// request), at most `maxFrames`. The sleep lets lavapipe's worker run; it is the test's, not the
-// layer's (the layer never waits in the frame path).
-State runUntilGrasping(App& app, const Ext& ext, int maxFrames = 400) {
+// request), for at most two minutes of wall time: no frame count, because how many frames a
+// build takes depends on the machine and on the driver's shader cache.
+State runUntilGrasping(App& app, const Ext& ext) {
   State s = graspState(app, ext);
-  for (int i = 0; i < maxFrames && !s.state.isGrasping; ++i) {
-    app.frame();
+  app.framesUntil([&] {
     s = graspState(app, ext);
-    if (!s.state.isGrasping) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
+    return s.state.isGrasping == XR_TRUE;
+  });
   return s;
+}
+
+// Waits (time-bounded) until the session's GPU path is ready: its pipelines made and warmed up
+// in the first frames, which with a cold shader cache takes lavapipe seconds. Then the right
+// hand at `grip` squeezes from the next frame. A grab before that would be built on the CPU.
+void squeezeWhenGpuReady(App& app, const Ext& ext, const XrPosef& grip) {
+  const bool ready = app.framesUntil([&] {
+    return graspState(app, ext).build.sessionBackend == XR_GRASP_SDF_BACKEND_VULKAN_SDFG;
+  });
+  REQUIRE(ready);
+  const uint64_t next = std::max<uint64_t>(app.framesEnded, 1);
+  REQUIRE(app.setScript(gripLine(0, "right", grip) + squeezeLine(0, "right", 0.0f) +
+                        squeezeLine(next - 1, "right", 0.0f) + squeezeLine(next, "right", 1.0f)) ==
+          XR_SUCCESS);
 }
 
 GraspOutcome outcome(const App& app, XrHandTrackerEXT tracker, const State& s) {
@@ -125,7 +139,7 @@ TEST_CASE("On a Vulkan session the grab-box SDF is built on the GPU and fingers 
     const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
     const XrVector3f centre = boxCentreInLocal(grip, /*right=*/true);
     const float radius = 0.04f;
-    applyEnv(squeezeEnv(grip));
+    applyEnv(squeezeEnv(grip, "on", /*squeeze=*/false));
     const size_t messagesBefore = vulkanMessages().size();
     {
       App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME},
@@ -135,9 +149,8 @@ TEST_CASE("On a Vulkan session the grab-box SDF is built on the GPU and fingers 
       Ext ext(app);
       XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
       makeTarget(app, ext, makeIcosphere(radius, 4), {{0, 0, 0, 1}, centre});
-      State s = graspState(app, ext);
-      CHECK(s.build.sessionBackend == XR_GRASP_SDF_BACKEND_VULKAN_SDFG);
-      s = runUntilGrasping(app, ext);
+      squeezeWhenGpuReady(app, ext, grip);
+      State s = runUntilGrasping(app, ext);
       REQUIRE(s.state.isGrasping);
       CHECK(s.build.graspBackend == XR_GRASP_SDF_BACKEND_VULKAN_SDFG);
       CHECK(s.build.gpuBuildCount >= 1);
@@ -222,11 +235,10 @@ TEST_CASE("A target in the app's Vulkan buffers (strided, 16-bit indices) is gra
       const uint64_t builds = s.build.gpuBuildCount;
       writeVertices(m, sphere, 0.85f);
       REQUIRE(update(t, &m.desc) == XR_SUCCESS);
-      for (int i = 0; i < 400 && s.build.gpuBuildCount == builds; ++i) {
-        app.frame();
+      app.framesUntil([&] {
         s = graspState(app, ext);
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-      }
+        return s.build.gpuBuildCount > builds;
+      });
       REQUIRE(s.build.gpuBuildCount > builds);
       REQUIRE(s.state.isGrasping);
       float curlAfter = 0.0f;
@@ -250,7 +262,7 @@ TEST_CASE(
   const XrVector3f centre = boxCentreInLocal(grip, /*right=*/true);
   for (bool wholeInstance : {false, true}) {
     CAPTURE(wholeInstance);
-    applyEnv(squeezeEnv(grip));
+    applyEnv(squeezeEnv(grip, "on", /*squeeze=*/false));
     const size_t messagesBefore = vulkanMessages().size();
     {
       App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME},
@@ -265,11 +277,13 @@ TEST_CASE(
       // processes kept both cores busy; the layer then leaks rather than free objects the GPU
       // may still use, and the validation layer reports them.)
       makeTarget(app, ext, makeIcosphere(0.04f, 4), {{0, 0, 0, 1}, centre});
+      squeezeWhenGpuReady(app, ext, grip);
       State s = graspState(app, ext);
-      for (int i = 0; i < 20 && s.build.pendingGpuBuilds == 0; ++i) {
-        app.frame();  // the frame's xrEndFrame submits what its xrSyncActions requested
+      // The frame's xrEndFrame submits what its xrSyncActions requested.
+      app.framesUntil([&] {
         s = graspState(app, ext);
-      }
+        return s.build.pendingGpuBuilds != 0;
+      });
       REQUIRE(s.build.pendingGpuBuilds == 1);
       CHECK_FALSE(s.state.isGrasping);
       const auto start = std::chrono::steady_clock::now();
@@ -295,7 +309,7 @@ TEST_CASE("A device loss on the GPU path falls back to the CPU and the hand stil
   // VK_ERROR_DEVICE_LOST from vkQueueSubmit, or from the fence poll while the real work runs.
   for (const char* fault : {"lost_at_submit", "lost_at_poll"}) {
     CAPTURE(fault);
-    XrEnv env = squeezeEnv(grip);
+    XrEnv env = squeezeEnv(grip, "on", /*squeeze=*/false);
     env.extra.push_back({"SDFG_AUTOGRASP_TEST_GPU_FAULT", fault});
     applyEnv(env);
     const size_t messagesBefore = vulkanMessages().size();
@@ -307,7 +321,8 @@ TEST_CASE("A device loss on the GPU path falls back to the CPU and the hand stil
       Ext ext(app);
       XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
       makeTarget(app, ext, makeIcosphere(radius, 4), {{0, 0, 0, 1}, centre});
-      State s = runUntilGrasping(app, ext, 50);
+      squeezeWhenGpuReady(app, ext, grip);
+      State s = runUntilGrasping(app, ext);
       REQUIRE(s.state.isGrasping);
       CHECK(s.build.gpuFailed);
       CHECK(s.build.graspBackend == XR_GRASP_SDF_BACKEND_CPU_SDFG);
@@ -346,8 +361,12 @@ TEST_CASE("With gpu = auto, array targets build on the CPU when the Vulkan devic
     makeTarget(app, ext, makeIcosphere(radius, 4), {{0, 0, 0, 1}, centre});
     State s = runUntilGrasping(app, ext);
     REQUIRE(s.state.isGrasping);
-    // The session keeps its device backend either way (buffer targets need it).
-    CHECK(s.build.sessionBackend == XR_GRASP_SDF_BACKEND_VULKAN_SDFG);
+    // The session keeps its device backend either way (buffer targets need it): it is ready
+    // once its pipelines are warmed up.
+    const bool ready = app.framesUntil([&] {
+      return graspState(app, ext).build.sessionBackend == XR_GRASP_SDF_BACKEND_VULKAN_SDFG;
+    });
+    CHECK(ready);
     CHECK(s.build.graspBackend ==
           (cpuDevice ? XR_GRASP_SDF_BACKEND_CPU_SDFG : XR_GRASP_SDF_BACKEND_VULKAN_SDFG));
     CHECK((s.build.cpuBuildCount > 0) == cpuDevice);
@@ -356,4 +375,67 @@ TEST_CASE("With gpu = auto, array targets build on the CPU when the Vulkan devic
                   [&](const XrVector3f& p) { return length(sub(p, centre)) - radius; });
   }
   CHECK(validationLog().empty());
+}
+
+TEST_CASE("A grab before the GPU path is ready is built on the CPU at once", "[layer][vulkan]") {
+  if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+  const XrVector3f centre = boxCentreInLocal(grip, /*right=*/true);
+  const float radius = 0.04f;
+  // The test-only key never_ready keeps the GPU path preparing for the whole session, as a
+  // driver still compiling would: the squeeze at frame 3 must not wait for it.
+  XrEnv env = squeezeEnv(grip);
+  env.extra.push_back({"SDFG_AUTOGRASP_TEST_GPU_FAULT", "never_ready"});
+  applyEnv(env);
+  const size_t messagesBefore = vulkanMessages().size();
+  {
+    App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME},
+             true,
+             Graphics::vulkan2});
+    REQUIRE(app.ok());
+    Ext ext(app);
+    XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
+    makeTarget(app, ext, makeIcosphere(radius, 4), {{0, 0, 0, 1}, centre});
+    const State s = runUntilGrasping(app, ext);
+    REQUIRE(s.state.isGrasping);
+    CHECK(s.build.graspBackend == XR_GRASP_SDF_BACKEND_CPU_SDFG);
+    CHECK(s.build.sessionBackend == XR_GRASP_SDF_BACKEND_CPU_SDFG);
+    CHECK_FALSE(s.build.gpuFailed);  // not a failure: the GPU is only not ready
+    CHECK(s.build.gpuBuildCount == 0);
+    CHECK(s.build.cpuBuildCount >= 1);
+    // Solved in the frame of the squeeze: the CPU build runs inside that xrSyncActions.
+    CHECK(app.framesEnded <= 5);
+    checkContacts(outcome(app, tracker, s),
+                  [&](const XrVector3f& p) { return length(sub(p, centre)) - radius; });
+  }
+  CHECK(validationLog().empty());
+  CHECK(vulkanMessages().size() == messagesBefore);
+}
+
+TEST_CASE("Destroying a session while its pipelines are being made neither hangs nor leaks",
+          "[layer][vulkan]") {
+  if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+  for (bool wholeInstance : {false, true}) {
+    CAPTURE(wholeInstance);
+    applyEnv(squeezeEnv(grip, "on", /*squeeze=*/false));
+    const size_t messagesBefore = vulkanMessages().size();
+    {
+      App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME},
+               true,
+               Graphics::vulkan2});
+      REQUIRE(app.ok());
+      // No frame yet: the preparation thread is making pipelines, or has made them and waits
+      // for a frame to submit the warm-ups.
+      const auto start = std::chrono::steady_clock::now();
+      if (wholeInstance) {
+        app.destroyInstance();
+      } else {
+        app.destroySession();
+      }
+      CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(3));
+    }  // the app destroys its device: the validation layer reports any object left on it
+    CHECK(validationLog().empty());
+    CHECK(vulkanMessages().size() == messagesBefore);
+  }
 }

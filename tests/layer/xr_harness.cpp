@@ -440,6 +440,13 @@ XrResult locateJoints(const App& app, XrHandTrackerEXT tracker, Joints& out,
   return locate(tracker, &info, &out.locations);
 }
 
+XrResult App::setScript(const std::string& text) const {
+  // The mock runtime's test-only command (tests/mock_runtime/mock_runtime_test.h).
+  using SetScript = XrResult(XRAPI_PTR*)(XrInstance, const char*);
+  const auto set = fn<SetScript>("xrMockRuntimeSetScriptSDFG");
+  return set == nullptr ? XR_ERROR_FUNCTION_UNSUPPORTED : set(instance, text.c_str());
+}
+
 std::string gripLine(uint64_t frame, const char* hand, const XrPosef& p) {
   char buf[256];
   std::snprintf(buf, sizeof buf, "%llu %s grip %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n",

@@ -14,7 +14,9 @@
 #include <openxr/XR_SDFG_auto_grasp.h>
 
 #include <array>
+#include <chrono>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace sdfg::test {
@@ -97,6 +99,23 @@ class App {
   void frames(int n) {
     for (int i = 0; i < n; ++i) frame();
   }
+  // Runs frames until `done()` holds, for at most `limit` of wall time; returns whether it held.
+  // Tests wait for an outcome this way, never for a number of frames: how many frames a build
+  // takes depends on the machine (a cold shader cache, cores busy with other work). The 1 ms
+  // between frames lets lavapipe's and the layer's threads run; the layer never waits itself.
+  template <class Done>
+  bool framesUntil(Done done, std::chrono::milliseconds limit = std::chrono::seconds(120)) {
+    const auto end = std::chrono::steady_clock::now() + limit;
+    while (!done()) {
+      if (std::chrono::steady_clock::now() > end) return false;
+      frame();
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return true;
+  }
+  // Replaces the mock runtime's input timeline (xrMockRuntimeSetScriptSDFG); its frame numbers
+  // are xrEndFrame counts, so `framesEnded + 1` is the next frame.
+  XrResult setScript(const std::string& text) const;
   // The app's own squeeze action state for a hand (to check the layer leaves it alone).
   float appSqueezeValue(int hand) const;
   void destroySession();

@@ -225,11 +225,15 @@ XrResult fail(const char* cmd, XrResult result, const char* fmt, ...) {
 }
 
 void registerHandle(Object* object) {
-  handleTable()[reinterpret_cast<uint64_t>(object)] = object;
+  // Starts high and odd-looking so a handle is never mistaken for a small integer or an index;
+  // only ever grows, so no value is handed out twice in a process.
+  static uint64_t next = 0x4D0C'0000'0000'0000ull;
+  if (object->handle == 0) object->handle = ++next;
+  handleTable()[object->handle] = object;
 }
 
 void unregisterHandle(const Object* object) {
-  handleTable().erase(reinterpret_cast<uint64_t>(object));
+  handleTable().erase(object->handle);
 }
 
 Object* findHandle(uint64_t handle) {

@@ -64,14 +64,18 @@ enum class Kind : uint32_t {
   handTracker
 };
 
-// Base of every object behind a handle; the handle value is the object's address, and it is
-// valid only while registered in the handle table.
+// Base of every object behind a handle. The handle value is drawn from a process-wide counter
+// at registration, never the object's address: a freed object's address is soon reused by the
+// next allocation, and a test of "a destroyed handle is refused" must not pass because the
+// destroyed handle happens to name a new object. Valid only while registered.
 struct Object {
   explicit Object(Kind k) : kind(k) {}
   virtual ~Object() = default;
   Kind kind;
+  uint64_t handle = 0;  // set by registerHandle; 0 before
 };
 
+// Gives `object` a handle value no object of this process had before, and registers it.
 void registerHandle(Object* object);
 void unregisterHandle(const Object* object);
 Object* findHandle(uint64_t handle);
@@ -84,7 +88,7 @@ T* lookup(H handle) {
 
 template <class H>
 H toHandle(const Object* o) {
-  return reinterpret_cast<H>(const_cast<Object*>(o));
+  return reinterpret_cast<H>(o->handle);
 }
 
 // ---- objects -------------------------------------------------------------------------------

@@ -29,7 +29,7 @@ class FakeDeferred final : public DeferredSdfBackend {
     ++requests;
     return Status::ok;
   }
-  bool hasDeviceMesh(uint64_t) const override { return false; }
+  bool hasDeviceMesh(uint64_t id) const override { return id != 0 && id == deviceMeshId; }
   bool needsSubmit(bool) const override {
     return !failed_ && (slots_[0].recorded || slots_[1].recorded);
   }
@@ -66,7 +66,16 @@ class FakeDeferred final : public DeferredSdfBackend {
     ++cancels;
   }
   bool failed() const override { return failed_; }
+  bool ready() override {
+    ++readyCalls;
+    if (failPreparation) failed_ = true;
+    return !preparing && !failed_;
+  }
 
+  bool preparing = false;        // still making its pipelines (ready() false)
+  bool failPreparation = false;  // the preparation fails at the next ready()
+  uint64_t deviceMeshId = 0;     // a target registered as living on the device
+  int readyCalls = 0;
   bool failAtPoll = false;
   bool busy = false;  // the device has not finished yet
   int requests = 0, submits = 0, cancels = 0;
@@ -164,5 +173,57 @@ TEST_CASE("GraspSession with a deferred backend solves only after the owner subm
     CHECK(session.addDeviceTarget(9, Aabb{glm::vec3(-0.1f), glm::vec3(0.1f)}) ==
           Status::unsupported);
     CHECK_FALSE(session.hasTarget(9));
+  }
+}
+
+TEST_CASE("While the deferred backend prepares, array targets build on the CPU at once",
+          "[grasp_session][deferred]") {
+  auto owned = std::make_unique<FakeDeferred>();
+  FakeDeferred& gpu = *owned;
+  gpu.preparing = true;
+  gpu.deviceMeshId = 9;
+  GraspSession session(makeCpuSdfBackend(1), std::move(owned));
+  REQUIRE(session.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
+  const TargetFrame target{7, true, Pose{}};
+  CHECK_FALSE(session.deferredReady());
+  CHECK(session.deferredUsable());
+
+  SECTION("an array target is grasped in the same update, on the CPU") {
+    REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    CHECK(session.grasp(Hand::right).holding);
+    CHECK(session.grasp(Hand::right).solves == 1);
+    CHECK_FALSE(session.grasp(Hand::right).builtOnGpu);
+    CHECK(session.buildStats().cpuBuilds == 1);
+    CHECK(gpu.requests == 0);
+    CHECK_FALSE(session.buildStats().gpuFailed);
+    // Once ready, the next grab goes to the device.
+    session.release(Hand::right);
+    gpu.preparing = false;
+    REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    CHECK(gpu.requests == 1);
+    CHECK(session.buildStats().cpuBuilds == 1);
+  }
+  SECTION("a device target waits for the backend, holding with no solve") {
+    Aabb bounds;
+    bounds.min = glm::vec3(-0.04f);
+    bounds.max = glm::vec3(0.04f);
+    REQUIRE(session.removeTarget(7));
+    REQUIRE(session.addDeviceTarget(9, bounds) == Status::ok);
+    const TargetFrame device{9, true, Pose{}};
+    for (int i = 0; i < 3; ++i)
+      REQUIRE(session.update(Hand::right, squeezing(1.0f), {&device, 1}) == Status::ok);
+    CHECK(session.grasp(Hand::right).holding);
+    CHECK(session.grasp(Hand::right).solves == 0);
+    CHECK(gpu.requests == 0);
+    CHECK(session.buildStats().cpuBuilds == 0);
+    CHECK(gpu.readyCalls >= 3);  // asked again at every update
+  }
+  SECTION("a failed preparation counts as a GPU failure; the CPU builds from then on") {
+    gpu.failPreparation = true;
+    REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    CHECK(session.grasp(Hand::right).solves == 1);
+    CHECK(session.buildStats().gpuFailed);
+    CHECK_FALSE(session.deferredUsable());
+    CHECK(gpu.requests == 0);
   }
 }

@@ -107,6 +107,13 @@ Status GraspSession::submitDeferred(bool sharedQueueFree) {
   return s;
 }
 
+bool GraspSession::deferredReady() {
+  if (deferred_ == nullptr) return false;
+  const bool ready = !deferred_->failed() && deferred_->ready();
+  if (deferred_->failed()) stats_.gpuFailed = true;  // its preparation failed
+  return ready;
+}
+
 void GraspSession::dropDeferred() {
   for (size_t h = 0; h < 2; ++h) hands_[h].pending = false;
   deferred_.reset();
@@ -177,7 +184,13 @@ Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Targ
       return s;
     hand.prepared = true;
   }
-  if (deferredUsable() && (target.distance == nullptr || deferredForMeshTargets_)) {
+  const bool onDevice = deferredUsable() && (target.distance == nullptr || deferredForMeshTargets_);
+  if (onDevice && !deferredReady()) {
+    // Still preparing (pipelines made at session start): a device target waits for it, asked
+    // again at the next update; a target with a CPU mesh is built on the CPU below rather than
+    // keep the hand waiting. A preparation that failed leaves the CPU only.
+    if (target.distance == nullptr && deferredUsable()) return Status::ok;
+  } else if (onDevice) {
     const TriangleMesh* mesh = target.distance ? &target.distance->mesh() : nullptr;
     const Status s =
         deferred_->request(slot, id, target.version, mesh, objectFromHand, settings_.box);

@@ -10,9 +10,11 @@
 // SDF builds: on the CPU backend during update(); or, with a DeferredSdfBackend (the app's Vulkan
 // device), requested during update(), submitted by the owner through submitDeferred() where it
 // may use the queue, and collected by a later update() (one frame or more of latency; a hand
-// counts as holding from the request, its grasp has solves == 0 until the first result). After a
-// failure of the deferred backend every build goes to the CPU; targets that exist only on the
-// device (addDeviceTarget) can no longer be grasped.
+// counts as holding from the request, its grasp has solves == 0 until the first result). While
+// the deferred backend is not ready yet (preparing its pipelines at session start) a target with
+// a CPU mesh is built on the CPU at once and a device target waits. After a failure of the
+// deferred backend every build goes to the CPU; targets that exist only on the device
+// (addDeviceTarget) can no longer be grasped.
 // Not thread-safe: the owner serializes calls (the layer holds its session lock).
 #pragma once
 
@@ -128,6 +130,9 @@ class GraspSession {
     return deferredUsable() && deferred_->needsSubmit(sharedQueueFree);
   }
   bool deferredUsable() const { return deferred_ != nullptr && !deferred_->failed(); }
+  // Whether the deferred backend takes builds now (see DeferredSdfBackend::ready: it may still
+  // be preparing; array targets are then built on the CPU, device targets wait).
+  bool deferredReady();
   DeferredSdfBackend* deferred() { return deferred_.get(); }
   // Whether targets added with a CPU mesh (addTarget) build on the deferred backend too (the
   // default) or on the CPU backend; device targets always use the deferred one.

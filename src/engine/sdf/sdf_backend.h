@@ -74,6 +74,11 @@ class DeferredSdfBackend {
   // Forgets the slot's request: an unsubmitted one is dropped, a running one's result discarded.
   virtual void cancel(size_t slot) = 0;
   virtual bool failed() const = 0;
+  // Whether builds may be requested now. A backend that prepares itself after creation
+  // (pipelines made on a thread of its own, a warm-up build that makes the driver compile them)
+  // answers false until that is done, advancing it without waiting; its owner builds on the CPU
+  // meanwhile. A failure of the preparation shows in failed().
+  virtual bool ready() { return true; }
 };
 
 }  // namespace sdfg

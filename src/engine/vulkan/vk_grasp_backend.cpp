@@ -22,6 +22,14 @@ Result<std::unique_ptr<VkGraspBackend>> VkGraspBackend::create(
   b->options_ = options;
   b->appQueue_ = appQueue;
   b->ownQueue_ = ownQueue != nullptr;
+  if (options.prepareInBackground) {
+    b->prep_ = Prep::making;
+    // With a queue of our own, builders for app-buffer targets (app's queue) are made now too,
+    // so that no setDeviceMesh creates pipelines on the app's thread.
+    b->preparer_ = std::thread(&VkGraspBackend::prepare, b.get(),
+                               ownQueue != nullptr ? *ownQueue : appQueue, ownQueue != nullptr);
+    return b;
+  }
   for (Slot& slot : b->slots_) {
     auto builder = b->makeBuilder(ownQueue != nullptr ? *ownQueue : appQueue);
     if (!builder) return builder.error();
@@ -31,7 +39,115 @@ Result<std::unique_ptr<VkGraspBackend>> VkGraspBackend::create(
   return b;
 }
 
+void VkGraspBackend::prepare(VulkanDevice mainQueue, bool appBuilders) {
+  Prepared made;
+  for (size_t i = 0; i < kSlots && !made.error && !cancelPrep_.load(); ++i) {
+    auto main = makeBuilder(mainQueue);
+    if (!main) {
+      made.error = main.error();
+      break;
+    }
+    made.main[i] = std::move(main.value());
+    if (!appBuilders) continue;
+    auto app = makeBuilder(appQueue_);
+    if (!app) {
+      made.error = app.error();
+      break;
+    }
+    made.app[i] = std::move(app.value());
+  }
+  {
+    std::lock_guard lock(prepMutex_);
+    made_ = std::move(made);
+  }
+  prepared_.store(true, std::memory_order_release);
+}
+
+void VkGraspBackend::adoptPrepared() {
+  if (preparer_.joinable()) preparer_.join();  // it has finished: prepared_ was set
+  Prepared made;
+  {
+    std::lock_guard lock(prepMutex_);
+    made = std::move(made_);
+  }
+  if (made.error) {
+    logOnce("sdfg: Vulkan SDF backend unavailable, falling back to the CPU: " +
+            made.error->message);
+    markFailed(made.error->code);
+    return;
+  }
+  for (size_t i = 0; i < kSlots; ++i) {
+    slots_[i].main.builder = std::move(made.main[i]);
+    slots_[i].main.shared = !ownQueue_;
+    slots_[i].main.warmups = 0;
+    if (made.app[i]) {
+      slots_[i].app.builder = std::move(made.app[i]);
+      slots_[i].app.shared = true;
+      slots_[i].app.warmups = 0;
+    }
+  }
+  prep_ = Prep::warming;
+}
+
+Status VkGraspBackend::submitWarmups(bool sharedQueueFree) {
+  // Small meshes in the middle of the default grab box (identity placement), so every pass has
+  // triangles and nodes to work on.
+  const GridBox box = [] {
+    GridBox b = GridBox::referenceDefault();
+    b.resolution = glm::uvec3(4u);
+    return b;
+  }();
+  const glm::vec3 c = box.handFromBox.position;
+  const float e = 0.02f;
+  TriangleMesh meshes[kWarmups];
+  meshes[0].positions = {c, c + glm::vec3(e, 0, 0), c + glm::vec3(0, e, 0)};
+  meshes[0].indices = {0, 1, 2};
+  meshes[1].positions = {c, c + glm::vec3(e, 0, 0), c + glm::vec3(0, e, 0), c + glm::vec3(0, 0, e)};
+  meshes[1].indices = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+  for (Slot& slot : slots_) {
+    for (Builder* b : {&slot.main, &slot.app}) {
+      if (!b->builder || b->warmups >= kWarmups || (b->shared && !sharedQueueFree)) continue;
+      const SdfPoll p = b->builder->poll();
+      if (p == SdfPoll::pending) continue;  // the previous warm-up still runs
+      if (p == SdfPoll::failed) return markFailed(Status::device_lost);
+      Status st = b->builder->setMesh(meshes[b->warmups]);
+      if (st == Status::ok) st = b->builder->submitBuild(box, Pose{}, {}, false);
+      if (st != Status::ok) return markFailed(st);
+      ++b->warmups;
+    }
+  }
+  return Status::ok;
+}
+
+bool VkGraspBackend::ready() {
+  if (failed_ || fault_ == VkGraspFault::neverReady) return false;
+  if (prep_ == Prep::done) return true;
+  if (prep_ == Prep::making) {
+    if (!prepared_.load(std::memory_order_acquire)) return false;
+    adoptPrepared();
+    if (failed_) return false;
+  }
+  for (Slot& slot : slots_) {
+    for (Builder* b : {&slot.main, &slot.app}) {
+      if (!b->builder) continue;
+      if (b->warmups < kWarmups) return false;
+      const SdfPoll p = b->builder->poll();
+      if (p == SdfPoll::pending) return false;
+      if (p == SdfPoll::failed) {
+        markFailed(Status::device_lost);
+        return false;
+      }
+    }
+  }
+  prep_ = Prep::done;
+  return true;
+}
+
 VkGraspBackend::~VkGraspBackend() {
+  // The preparation thread stops after the builder it is making; builders it made and nobody
+  // adopted are destroyed with made_.
+  cancelPrep_.store(true);
+  if (preparer_.joinable()) preparer_.join();
   // Each builder's destructor waits for its submission in flight before freeing anything.
   for (Slot& slot : slots_) {
     slot.main.builder.reset();
@@ -40,6 +156,7 @@ VkGraspBackend::~VkGraspBackend() {
 }
 
 void VkGraspBackend::logOnce(const std::string& line) {
+  std::lock_guard lock(logMutex_);
   if (logged_) return;
   logged_ = true;
   if (options_.log) {
@@ -63,6 +180,7 @@ Status VkGraspBackend::markFailed(Status status) {
 Status VkGraspBackend::request(size_t slot, uint64_t id, uint64_t version, const TriangleMesh* mesh,
                                const Pose& objectFromHand, const GridBox& box) {
   if (failed_) return Status::device_lost;
+  if (prep_ != Prep::done) return Status::unsupported;  // see ready()
   if (slot >= kSlots || box.validate()) return Status::invalid_argument;
   Slot& s = slots_[slot];
   if (s.recorded) return Status::unsupported;
@@ -108,6 +226,15 @@ Status VkGraspBackend::request(size_t slot, uint64_t id, uint64_t version, const
 
 bool VkGraspBackend::needsSubmit(bool sharedQueueFree) const {
   if (failed_) return false;
+  if (prep_ == Prep::making) return prepared_.load(std::memory_order_acquire);
+  if (prep_ == Prep::warming) {
+    for (const Slot& s : slots_) {
+      for (const Builder* b : {&s.main, &s.app}) {
+        if (b->builder && b->warmups < kWarmups && (sharedQueueFree || !b->shared)) return true;
+      }
+    }
+    return false;
+  }
   for (const Slot& s : slots_) {
     if (s.recorded && (sharedQueueFree || !s.active->shared)) return true;
   }
@@ -116,6 +243,12 @@ bool VkGraspBackend::needsSubmit(bool sharedQueueFree) const {
 
 Status VkGraspBackend::submit(bool sharedQueueFree) {
   if (failed_) return Status::device_lost;
+  if (prep_ == Prep::making) {
+    if (!prepared_.load(std::memory_order_acquire)) return Status::ok;
+    adoptPrepared();
+    if (failed_) return Status::device_lost;
+  }
+  if (prep_ == Prep::warming) return submitWarmups(sharedQueueFree);
   for (Slot& s : slots_) {
     if (!s.recorded || (s.active->shared && !sharedQueueFree)) continue;
     VkSdfBuilder& builder = *s.active->builder;
@@ -176,8 +309,9 @@ Status VkGraspBackend::setDeviceMesh(uint64_t id, const VkMeshBuffers& buffers) 
       buffers.indexCount / 3 > (1u << 30) || buffers.positionOffset / 4 > UINT32_MAX ||
       buffers.indexOffset / indexSize > UINT32_MAX)
     return Status::invalid_argument;
-  if (ownQueue_) {
-    // App buffers are read on the app's queue (see the header): builders there, made once.
+  if (ownQueue_ && !options_.prepareInBackground) {
+    // App buffers are read on the app's queue (see the header): builders there, made once (by
+    // the preparation thread when there is one).
     for (Slot& slot : slots_) {
       if (slot.app.builder) continue;
       auto builder = makeBuilder(appQueue_);

@@ -15,13 +15,25 @@
 // options.log, marks the backend failed, and every later call answers failed / device_lost; the
 // session continues on the CPU. Destruction waits (at most 2 s per slot) for work in flight, so
 // the app may destroy its device and buffers afterwards.
+//
+// Preparation (options.prepareInBackground, the layer's choice): create() returns at once; a
+// thread of the backend makes the builders (shader modules, pipelines: device-level create
+// calls, which Vulkan allows from any thread), then each builder runs two small warm-up builds
+// on its queue, submitted by submit() like any build, so that a driver that compiles at the
+// first dispatch (Mesa's lavapipe: seconds with a cold shader cache) does so before the user's
+// first grab, not during it. ready() says when builds may be requested; until then the owner
+// builds on the CPU. Destruction stops the thread between builders and joins it.
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
+#include <thread>
 #include <unordered_map>
 
 #include "sdf/sdf_backend.h"
@@ -30,19 +42,24 @@
 namespace sdfg {
 
 struct VkGraspBackendOptions {
-  // Where the one failure line goes (stderr when empty).
+  // Where the one failure line goes (stderr when empty). Called from the preparation thread too.
   std::function<void(const std::string&)> log;
+  // Make the builders on a thread of the backend and warm them up (see the header comment)
+  // instead of inside create().
+  bool prepareInBackground = false;
 };
 
 // Test hooks: a simulated VK_ERROR_DEVICE_LOST at the first submission, or at the poll after it
-// (the real work then still runs, so destruction must wait for it).
-enum class VkGraspFault { none, lostAtSubmit, lostAtPoll };
+// (the real work then still runs, so destruction must wait for it); or a preparation that never
+// ends (ready() stays false: a driver still compiling).
+enum class VkGraspFault { none, lostAtSubmit, lostAtPoll, neverReady };
 
 class VkGraspBackend final : public DeferredSdfBackend {
  public:
   // Builds one VkSdfBuilder per slot on `appQueue` (pipelines included: do this outside the
   // frame loop), or on `ownQueue` when given (then app-queue builders are made at the first
-  // setDeviceMesh). Errors: those of VkSdfBuilder::create.
+  // setDeviceMesh). Errors: those of VkSdfBuilder::create. With prepareInBackground nothing is
+  // made here and no error is returned: a failure of the preparation marks the backend failed.
   static Result<std::unique_ptr<VkGraspBackend>> create(const VulkanDevice& appQueue,
                                                         const VulkanDevice* ownQueue = nullptr,
                                                         const VkGraspBackendOptions& options = {});
@@ -57,6 +74,7 @@ class VkGraspBackend final : public DeferredSdfBackend {
   BuildPoll poll(size_t slot, SdfGrid& out) override;
   void cancel(size_t slot) override;
   bool failed() const override { return failed_; }
+  bool ready() override;
 
   // Registers (or replaces) the app-buffer mesh of target `id`. The buffers are borrowed: see
   // VkMeshBuffers. Errors: invalid_argument (see VkSdfBuilder::setMesh(VkMeshBuffers)),
@@ -77,7 +95,17 @@ class VkGraspBackend final : public DeferredSdfBackend {
     uint64_t meshId = 0;  // the mesh set on the builder (0: none)
     uint64_t meshVersion = 0;
     bool meshOnDevice = false;
+    int warmups = kWarmups;  // warm-up builds submitted (kWarmups: none left to do)
   };
+  // Warm-up builds per builder: an open triangle (winding-number sign, cluster pass) and a
+  // closed tetrahedron (pseudo-normal sign, repair pass), so every pipeline a build uses runs.
+  static constexpr int kWarmups = 2;
+  // What the preparation thread made, handed over under prepMutex_.
+  struct Prepared {
+    std::array<std::unique_ptr<VkSdfBuilder>, kSlots> main, app;
+    std::optional<Error> error;
+  };
+  enum class Prep { making, warming, done };
   struct Slot {
     Builder main;               // own queue when there is one, else the app's
     Builder app;                // app-buffer targets when `main` is on the own queue
@@ -97,6 +125,12 @@ class VkGraspBackend final : public DeferredSdfBackend {
   Status markFailed(Status status);
   void logOnce(const std::string& line);
   Result<std::unique_ptr<VkSdfBuilder>> makeBuilder(const VulkanDevice& device);
+  // Body of the preparation thread: makes every builder into made_.
+  void prepare(VulkanDevice mainQueue, bool appBuilders);
+  // Takes what the finished thread made into the slots (or fails the backend).
+  void adoptPrepared();
+  // Submits the next warm-up build of each builder whose queue may be used now.
+  Status submitWarmups(bool sharedQueueFree);
 
   std::array<Slot, kSlots> slots_;
   VulkanDevice appQueue_{};
@@ -105,7 +139,15 @@ class VkGraspBackend final : public DeferredSdfBackend {
   VkGraspBackendOptions options_;
   VkGraspFault fault_ = VkGraspFault::none;
   bool failed_ = false;
-  bool logged_ = false;
+  std::mutex logMutex_;  // logOnce runs on the preparation thread too
+  bool logged_ = false;  // guarded by logMutex_
+
+  Prep prep_ = Prep::done;
+  std::thread preparer_;
+  std::atomic<bool> prepared_{false};    // the thread has stored its result in made_
+  std::atomic<bool> cancelPrep_{false};  // destruction: stop between builders
+  std::mutex prepMutex_;
+  Prepared made_;  // guarded by prepMutex_
 };
 
 }  // namespace sdfg

@@ -1,0 +1,49 @@
+// autograsp-bench's command line: the options, their usage text and their parser.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sdf_backends.h"
+
+namespace sdfg::bench {
+
+// Exit code of a run that completed without a backend it was asked for (no Vulkan device).
+constexpr int kExitBackendUnavailable = 3;
+
+extern const char* const kUsage;
+
+struct Options {
+  std::vector<std::string> meshes;
+  bool embedded = false;
+  bool embeddedOnly = false;
+  bool thinPlateSet = false;
+  int placements = 1000;
+  uint64_t seed = 1;
+  std::vector<std::string> methods;
+  float da = 0.1f;
+  int resolution = 16;
+  unsigned threads = 0;
+  float sdfFarBand = 0.0f;  // CpuSdfOptions::exactBand of the cpu builder
+  bool exactCheck = true;   // pass GraspScene::exact ("ours" checks its stops on the mesh)
+  std::vector<std::string> sdfBackends = {tools::kCpuBackend};
+  bool sdfBackendsGiven = false;  // else --scaling compares cpu and vulkan
+  std::string json;
+  std::string report;
+  std::string scalingJson;  // the sweep's figures as JSON
+  std::string scalingFrom;  // a sweep's JSON to report instead of sweeping again
+  bool scaling = false;
+  bool scalingQuick = false;
+  std::string reportFrom;  // a results JSON to report on instead of running
+};
+
+struct UsageError {
+  std::string message;
+};
+
+// Fills `o` from the arguments; `help` is set for --help. Returns the first usage error.
+std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& help);
+
+}  // namespace sdfg::bench

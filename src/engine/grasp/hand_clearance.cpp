@@ -81,13 +81,15 @@ class Measure {
                 glm::all(glm::lessThanEqual(uvw, glm::vec3(1.0f)));
         if (inBox) {
           fieldD = field_->sample(p.point);
-          const glm::vec3 g = field_->gradient(p.point);
-          const float gl = glm::length(g);
           p.c = fieldD - part.coverRadius;
-          if (gl > 1e-3f) p.g = g / gl;
+          if (gradients) {
+            const glm::vec3 g = field_->gradient(p.point);
+            const float gl = glm::length(g);
+            if (gl > 1e-3f) p.g = g / gl;
+          }
         }
       }
-      if (exact_ == nullptr) continue;
+      if (exact_ == nullptr || !exactOn) continue;
       // Clear by more than the field can be wrong: no exact sample needed.
       if (inBox && p.c > margin_ + kActiveBand + kFieldTrust) continue;
       points_[asked] = p.point;
@@ -126,6 +128,11 @@ class Measure {
   }
 
   int sampled() const { return sampled_; }
+  // False: the field alone, even where there is an exact source (the searches' first phase).
+  bool exactOn = true;
+  // False: values only (a march needs no direction; the field's gradient costs six samples).
+  bool gradients = true;
+  bool hasBoth() const { return field_ != nullptr && exact_ != nullptr; }
 
  private:
   std::span<const HandPart> parts_;
@@ -167,12 +174,11 @@ struct Candidate {
 };
 
 // The least-norm projection (see the file comment); `turn` adds the three rotation variables.
+// `z` = (t, kLever * w) is where it starts, and where it ended on return; the objective is |z|^2.
 Candidate project(std::span<const HandPart> parts, const glm::vec3& pivot, const Pose& start,
                   Measure& measure, Probes& probes, const ClearanceOptions& o, bool turn,
-                  int& iterations) {
+                  int& iterations, std::array<float, 6>& z) {
   const glm::vec3 o0 = start.transformPoint(pivot);
-  // z = (t, kLever * w): the objective is |z|^2.
-  std::array<float, 6> z{};
   std::array<std::array<float, 6>, kMaxHandParts> rows{};
   std::array<float, kMaxHandParts> b{}, lambda{}, norm2{};
   const int vars = turn ? 6 : 3;
@@ -241,13 +247,29 @@ Candidate project(std::span<const HandPart> parts, const glm::vec3& pivot, const
   return out;
 }
 
-// Along `dir` from `start`: the first translation that clears every part, within the bound.
+// The projection on the field alone first, then on the exact source from where that ended: the
+// exact searches (microseconds each on dense meshes) are spent only near the answer.
+Candidate projectInPhases(std::span<const HandPart> parts, const glm::vec3& pivot,
+                          const Pose& start, Measure& measure, Probes& probes,
+                          const ClearanceOptions& o, bool turn, int& iterations) {
+  std::array<float, 6> z{};
+  if (measure.hasBoth()) {
+    measure.exactOn = false;
+    (void)project(parts, pivot, start, measure, probes, o, turn, iterations, z);
+    measure.exactOn = true;
+  }
+  return project(parts, pivot, start, measure, probes, o, turn, iterations, z);
+}
+
+// Along `dir` from `start` + `from`: the first translation that clears every part, within the
+// bound (and below bestSoFar). Starting before the first clear point, it never steps past it.
 Candidate march(std::span<const HandPart> parts, const Pose& start, Measure& measure,
                 Probes& probes, const ClearanceOptions& o, const glm::vec3& dir, float bestSoFar,
-                int& iterations) {
+                int& iterations, float from = 0.0f) {
   Candidate out;
-  float s = 0.0f;
+  float s = from;
   const float limit = std::min(o.maxCorrection, bestSoFar);
+  measure.gradients = false;
   for (int k = 0; k < kMaxMarchSteps && s <= limit; ++k) {
     ++iterations;
     Pose c = start;
@@ -259,6 +281,7 @@ Candidate march(std::span<const HandPart> parts, const Pose& start, Measure& mea
     }
     s += std::max(kMinMarchStep, o.margin - lowest);
   }
+  measure.gradients = true;
   (void)parts;
   return out;
 }
@@ -326,11 +349,15 @@ Result<ClearanceResult> clearHand(std::span<const HandPart> parts, const glm::ve
   r.handCorrection = start;
   Measure measure(parts, field, exact, o.margin);
   Probes probes{};
+  // Most grabs start clear: values only for that answer, directions only when inside.
+  measure.gradients = false;
   r.clearanceBefore = measure(start, probes);
+  measure.gradients = true;
   r.clearanceAfter = r.clearanceBefore;
   r.wasInside = r.clearanceBefore < 0.0f;
   r.exactSamples = measure.sampled();
   if (!r.wasInside) return r;
+  (void)measure(start, probes);
 
   // The directions the deepest parts point out, before any search overwrites the probes.
   std::array<glm::vec3, 6 + kPartDirections> dirs{};
@@ -358,13 +385,36 @@ Result<ClearanceResult> clearHand(std::span<const HandPart> parts, const glm::ve
     }
   }
 
-  Candidate best = project(parts, pivot, start, measure, probes, o, false, r.iterations);
+  Candidate best = projectInPhases(parts, pivot, start, measure, probes, o, false, r.iterations);
+  // Each direction is marched on the field first; the exact march then starts kFieldTrust short
+  // of the field's answer, nearest first, and only while it can still beat the best so far.
+  std::array<float, 6 + kPartDirections> fieldStop{};
+  std::array<int, 6 + kPartDirections> order{};
   for (int d = 0; d < dirCount; ++d) {
-    const Candidate c = march(parts, start, measure, probes, o, dirs[d], best.moved, r.iterations);
+    order[d] = d;
+    fieldStop[d] = 0.0f;
+    if (!measure.hasBoth()) continue;
+    measure.exactOn = false;
+    ClearanceOptions reach = o;  // the field may need up to kFieldTrust more than the mesh
+    reach.maxCorrection += kFieldTrust;
+    const Candidate f = march(parts, start, measure, probes, reach, dirs[d],
+                              std::numeric_limits<float>::infinity(), r.iterations);
+    measure.exactOn = true;
+    fieldStop[d] =
+        f.valid() ? std::max(0.0f, f.moved - kFieldTrust) : std::numeric_limits<float>::infinity();
+  }
+  std::sort(order.begin(), order.begin() + dirCount,
+            [&](int x, int y) { return fieldStop[x] < fieldStop[y]; });
+  for (int k = 0; k < dirCount; ++k) {
+    const int d = order[k];
+    if (!(fieldStop[d] < std::min(best.moved, o.maxCorrection))) break;
+    const Candidate c =
+        march(parts, start, measure, probes, o, dirs[d], best.moved, r.iterations, fieldStop[d]);
     if (c.valid() && c.moved < best.moved) best = c;
   }
   if (o.rotation) {
-    const Candidate c = project(parts, pivot, start, measure, probes, o, true, r.iterations);
+    const Candidate c =
+        projectInPhases(parts, pivot, start, measure, probes, o, true, r.iterations);
     if (c.valid() && (!best.valid() || c.moved < o.rotationGain * best.moved)) best = c;
   }
   r.exactSamples = measure.sampled();

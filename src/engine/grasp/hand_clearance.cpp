@@ -12,7 +12,9 @@
 //   stepped over. It handles what the linearisation cannot: thin parts whose two faces push a
 //   bone both ways, and convex corners, where the single-face exit is the smallest.
 // A turn about the palm is then tried with the projection in six variables, its cost the
-// motion it gives at kLever from the pivot.
+// motion it gives at kLever from the pivot. Every search runs on the field first and then, where
+// the scene has an exact source, on the exact distance from where the field's search ended, so
+// the exact searches (microseconds each on dense meshes) are spent only near the answer.
 #include "grasp/hand_clearance.h"
 
 #include <algorithm>

@@ -11,7 +11,8 @@
 namespace sdfg::bench {
 
 // Writes one markdown table: per mesh and method, three lines (all grasps, open hand inside,
-// open hand clear).
+// open hand clear); the last column counts the grasps whose hand needed more than the
+// clearance's bound and was left where it was.
 void printApproachingTable(std::FILE* out, const std::vector<Row>& rows);
 
 }  // namespace sdfg::bench

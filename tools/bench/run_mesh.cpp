@@ -348,6 +348,7 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
         row.handMovedMm.push_back(results[m][p].handMoved * 1000.0);
         row.openInside.push_back(openInside[p]);
         row.graspContacts.push_back(g.contacts);
+        row.pastBound.push_back(results[m][p].clearanceExceeded ? 1 : 0);
       }
       for (int f = 0; f < kFingerCount; ++f) {
         const FingerMetrics& fm = g.fingers[f];

@@ -54,6 +54,7 @@ struct Row {
   std::vector<double> handMovedMm;
   std::vector<char> openInside;
   std::vector<int> graspContacts;
+  std::vector<char> pastBound;  // the hand needed more than the clearance's bound: not moved
 
   double contactsMean() const { return grasps > 0 ? double(contacts) / grasps : std::nan(""); }
 };

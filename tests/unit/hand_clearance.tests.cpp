@@ -11,6 +11,7 @@
 
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
 
 #include "grasp/hand_clearance.h"
 #include "grasp/solver.h"
@@ -442,5 +443,49 @@ TEST_CASE("ours: a palm inside the target is cleared before the fingers close",
     const GraspResult r = solveOurs(open.model, grid, &exact, o);
     CHECK(r.clearanceExceeded);
     CHECK(r.handMoved == 0.0f);
+  }
+}
+
+TEST_CASE("ours: the approach brings only a palm within its range and angle onto the surface",
+          "[clearance][ours][approach]") {
+  const OpenHand open;
+  // A floor 2 cm under the palm's lowest point, the palm facing it.
+  const float palmBottom = open.palm.y - open.model.jointRadius(Joint::palm);
+  const Shape floor = halfSpace(glm::vec3(0.0f, palmBottom - 0.02f, 0.0f), glm::vec3(0, 1, 0));
+  const SdfGrid grid = analyticGrid(floor);
+  const AnalyticSource exact(floor);
+  REQUIRE(clearance(open.span(), floor) > 0.0f);
+  SolverOptions o;
+  o.approach = true;
+  o.approachRange = 0.05f;
+  SECTION("within range: the hand comes down onto the floor and ends clear") {
+    const GraspResult r = solveOurs(open.model, grid, &exact, o);
+    // Down toward the floor (the clearance then keeps the fingers, lower than the palm, out).
+    CHECK(r.handMoved > 0.003f);
+    CHECK(r.handCorrection.position.y < -0.003f);
+    CHECK(wholeHandClearance(open.model, r, floor) > -2e-4f);
+  }
+  SECTION("out of range: the hand stays") {
+    o.approachRange = 0.01f;
+    const GraspResult r = solveOurs(open.model, grid, &exact, o);
+    CHECK(r.handMoved == 0.0f);
+  }
+  SECTION("turned away beyond the angle: the hand stays") {
+    // A floor whose normal is 0.3 rad off the palm's: refused at 0.2, taken at 0.4.
+    JointPoses joints{};
+    open.model.pose(FingerCurls{}, joints);
+    const glm::vec3 palmNormal =
+        joints[size_t(Joint::palm)].transformVector(glm::vec3(0.0f, -1.0f, 0.0f));
+    const glm::vec3 axis = glm::normalize(glm::cross(palmNormal, glm::vec3(1.0f, 0.0f, 0.0f)));
+    const glm::vec3 down = glm::angleAxis(0.3f, axis) * palmNormal;
+    const Shape tilted =
+        halfSpace(open.palm + down * (open.model.jointRadius(Joint::palm) + 0.02f), -down);
+    const SdfGrid tiltedGrid = analyticGrid(tilted);
+    const AnalyticSource tiltedExact(tilted);
+    REQUIRE(clearance(open.span(), tilted) > 0.0f);
+    o.approachMaxAngle = 0.2f;
+    CHECK(solveOurs(open.model, tiltedGrid, &tiltedExact, o).handMoved == 0.0f);
+    o.approachMaxAngle = 0.4f;
+    CHECK(solveOurs(open.model, tiltedGrid, &tiltedExact, o).handMoved > 0.003f);
   }
 }

@@ -29,9 +29,15 @@ bool parseBool(const std::string& text, bool& out) {
   return false;
 }
 
-const char* const kKeys[] = {"log_level",  "solver",    "grab_threshold", "release_ratio",
-                             "resolution", "curl_step", "exact_check",    "sdf_far_band",
-                             "synthesis",  "gpu",       "extra_queue",    "test_gpu_fault"};
+const char* const kKeys[] = {"log_level",          "solver",
+                             "grab_threshold",     "release_ratio",
+                             "resolution",         "curl_step",
+                             "exact_check",        "sdf_far_band",
+                             "synthesis",          "gpu",
+                             "extra_queue",        "test_gpu_fault",
+                             "clear_hand",         "clear_bound",
+                             "approach",           "approach_range",
+                             "approach_max_angle", "offset_blend_time"};
 
 }  // namespace
 
@@ -71,6 +77,18 @@ bool applyConfigValue(Config& config, const std::string& key, const std::string&
     }
   } else if (key == "extra_queue") {
     ok = parseBool(value, c.extraQueue);
+  } else if (key == "clear_hand") {
+    ok = parseBool(value, c.clearHand);
+  } else if (key == "clear_bound") {
+    ok = parseFloat(value, 0.0f, 0.2f, c.clearBound);
+  } else if (key == "approach") {
+    ok = parseBool(value, c.approach);
+  } else if (key == "approach_range") {
+    ok = parseFloat(value, 0.001f, 0.2f, c.approachRange);
+  } else if (key == "approach_max_angle") {
+    ok = parseFloat(value, 0.1f, 180.0f, c.approachMaxAngle);
+  } else if (key == "offset_blend_time") {
+    ok = parseFloat(value, 0.0f, 2.0f, c.offsetBlendTime);
   } else if (key == "test_gpu_fault") {
     ok = value == "none" || value == "lost_at_submit" || value == "lost_at_poll" ||
          value == "never_ready";

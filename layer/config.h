@@ -34,6 +34,14 @@ struct Config {
   // never_ready (the GPU path never finishes preparing, as if the driver compiled forever)
   std::string testGpuFault = "none";
   std::string configPath;  // the file that was read, empty when none
+  // Never inside (docs/layer.md, "The hand's clearance"): clear_hand, clear_bound (metres),
+  // approach, approach_range (metres), approach_max_angle (degrees), offset_blend_time (s).
+  bool clearHand = true;
+  float clearBound = 0.03f;
+  bool approach = false;
+  float approachRange = 0.03f;
+  float approachMaxAngle = 30.0f;
+  float offsetBlendTime = 0.1f;
 };
 
 Config loadConfig();

@@ -425,12 +425,14 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
     const FingerState& fs = g.result.fingers[f];
     out.curl = held ? fs.curl : 0.0f;
     out.inContact = held && fs.contact ? XR_TRUE : XR_FALSE;
-    // Version 2: the touching sphere's centre and the signed distance there (contact.h).
+    // Version 2: the touching sphere (in the corrected hand: the hand may have been moved out
+    // first)'s centre and the signed distance there (contact.h).
     const FingerContact& c = g.contacts[f];
     const bool honest = held && fs.contact && c.valid;
-    const glm::vec3 p = honest ? c.center
-                        : held ? g.objectFromHand.transformPoint(fs.contactPoint)
-                               : glm::vec3(0.0f);
+    const glm::vec3 p =
+        honest ? c.center
+        : held ? (g.objectFromHand * g.result.handCorrection).transformPoint(fs.contactPoint)
+               : glm::vec3(0.0f);
     out.contactPoint = {p.x, p.y, p.z};
     out.distance = honest ? c.distance : held ? fs.distance : 0.0f;
   }
@@ -457,6 +459,7 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
       if (st == TargetSetup::failed) ++setup->failedCount;
     }
   }
+  writeHandOffset(*s, hand == Hand::left ? 0 : 1, state->next);
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)
 }
@@ -495,6 +498,8 @@ XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession session,
               XR_ERROR_VALIDATION_FAILURE, "(options->curlStep) must be 0 or in (1e-5, 1]");
   SDFG_VERIFY(cmd, o.grabThreshold == 0.0f || (o.grabThreshold > 0.0f && o.grabThreshold <= 1.0f),
               XR_ERROR_VALIDATION_FAILURE, "(options->grabThreshold) must be 0 or in (0, 1]");
+  ClearanceRequest clearance;
+  if (XrResult r = readClearanceOptions(cmd, o.next, clearance); r != XR_SUCCESS) return r;
 
   std::lock_guard lock(s->mutex);
   SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
@@ -509,6 +514,8 @@ XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession session,
   if (o.resolution != 0) settings.box.resolution = glm::uvec3(o.resolution);
   if (o.curlStep != 0.0f) settings.solverOptions.da = o.curlStep;
   if (o.grabThreshold != 0.0f) settings.grabThreshold = o.grabThreshold;
+  float blendTime = s->instance->config.offsetBlendTime;
+  clearance.apply(settings, blendTime);
   if (Status st = s->grasp->configure(settings); st != Status::ok)
     return logError(st == Status::invalid_argument && solver == XR_GRASP_SOLVER_OURS_SDFG
                         ? XR_ERROR_FEATURE_UNSUPPORTED
@@ -516,6 +523,7 @@ XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession session,
                     cmd, "the options were refused (%s; solver '%s')", toString(st),
                     settings.solver.c_str());
   s->settings = settings;
+  s->offsets.blendTime = blendTime;
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)
 }

@@ -144,6 +144,7 @@ void updateGrasps(SessionState& s) {
     if (Status st = s.grasp->update(hand, frame, frames); st != Status::ok)
       SDFG_LOG_WARN(cmd, "grasp solve failed (%s); the hand stays open", toString(st));
     noteGraspChange(s, hand, wasGrasping, wasTarget);
+    advanceHandOffset(s, h);
   }
   // Set-ups run on the session's worker: one line per target whose mesh it could not take.
   for (const auto& [id, why] : s.grasp->takeSetupFailures())
@@ -269,7 +270,10 @@ XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT tracker,
       std::lock_guard lock(s->mutex);
       if (s->grasp == nullptr) return r;
       const HandGrasp& grasp = s->grasp->grasp(t->hand);
-      if (!grasp.holding || grasp.solves == 0) return r;  // pass-through: untouched
+      const HandOffset& offset = s->offsets.hands[t->hand == Hand::left ? 0 : 1];
+      const bool held = grasp.holding && grasp.solves > 0;
+      // Pass-through, untouched, unless a grasp is held or its offset still blends out.
+      if (!held && offset.blend <= 0.0f) return r;
       JointPoses joints;
       for (int j = 0; j < kJointCount; ++j) joints[j] = toPose(locations->jointLocations[j].pose);
       const Pose wristFromBase = joints[size_t(Joint::wrist)].inverse();
@@ -286,13 +290,22 @@ XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT tracker,
       }
       const HandModel& model = s->grasp->model(t->hand);
       FingerJointCurls curls;
-      std::array<bool, kFingerCount> replace;
-      graspCurls(grasp, model.estimateCurls(local), curls, replace);
-      replaceFingers(model, curls, replace, baseFromWrist, joints);
-      for (int f = 0; f < kFingerCount; ++f) {
-        if (!replace[f]) continue;
-        for (Joint j : fingerJoints(static_cast<Finger>(f)))
-          locations->jointLocations[size_t(j)].pose = toXr(joints[size_t(j)]);
+      std::array<bool, kFingerCount> replace{};
+      if (held) {
+        graspCurls(grasp, model.estimateCurls(local), curls, replace);
+        replaceFingers(model, curls, replace, baseFromWrist, joints);
+      }
+      if (offset.blend > 0.0f) {
+        // The whole hand moves out of the object, every joint (wrist and palm too).
+        applyHandOffset(shownHandOffset(offset), joints);
+        for (int j = 0; j < kJointCount; ++j)
+          locations->jointLocations[j].pose = toXr(joints[size_t(j)]);
+      } else {
+        for (int f = 0; f < kFingerCount; ++f) {
+          if (!replace[f]) continue;
+          for (Joint j : fingerJoints(static_cast<Finger>(f)))
+            locations->jointLocations[size_t(j)].pose = toXr(joints[size_t(j)]);
+        }
       }
     } catch (...) {
       SDFG_LOG_WARN(cmd, "applying the grasp failed; joints pass through");
@@ -376,6 +389,8 @@ XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT tracker,
     graspCurls(grasp, user, curls, replace);
     replaceFingers(model, curls, replace, baseFromWrist, joints);
   }
+  if (const HandOffset& offset = s->offsets.hands[size_t(h)]; offset.blend > 0.0f)
+    applyHandOffset(shownHandOffset(offset), joints);
   lock.unlock();
   for (int j = 0; j < kJointCount; ++j) {
     XrHandJointLocationEXT& l = locations->jointLocations[j];

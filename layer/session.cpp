@@ -107,6 +107,7 @@ XrResult XRAPI_CALL SdfgXrCreateSession(XrInstance instance, const XrSessionCrea
     s->vulkanBinding.next = nullptr;
   }
   s->settings = settingsFromConfig(state->config);
+  s->offsets.blendTime = state->config.offsetBlendTime;
   // Vulkan sessions build on the app's device (vulkan.cpp); the CPU builder is the fallback and
   // the path of every other session.
   std::unique_ptr<DeferredSdfBackend> gpu;

@@ -90,6 +90,11 @@ GraspSettings settingsFromConfig(const Config& config) {
   s.box.resolution = glm::uvec3(config.resolution);
   s.grabThreshold = config.grabThreshold;
   s.releaseRatio = config.releaseRatio;
+  s.solverOptions.clearance = config.clearHand;
+  s.solverOptions.clearanceBound = config.clearBound;
+  s.solverOptions.approach = config.approach;
+  s.solverOptions.approachRange = config.approachRange;
+  s.solverOptions.approachMaxAngle = config.approachMaxAngle * 3.14159265f / 180.0f;
   return s;
 }
 

@@ -18,6 +18,7 @@
 #include "events.h"
 #include "grasp/grasp_session.h"
 #include "hand/hand_synthesis.h"
+#include "hand_offset.h"
 #include "xr_includes.h"
 
 namespace sdfg {
@@ -149,6 +150,7 @@ struct SessionState {
   bool gpuForArrayTargets = false;
   GraspSettings settings;
   std::unordered_map<uint64_t, std::shared_ptr<TargetState>> targets;
+  HandOffsets offsets;  // the hands' offsets off their tracked poses (hand_offset.h)
 };
 
 struct TrackerState {

@@ -191,6 +191,24 @@ if(NOT exact STREQUAL "OFF" OR NOT types STREQUAL "none;none;none"
 endif()
 check_rows("${json}" 3)
 
+# 1c. --approaching: the open hand may start inside; the table splits the grasps by that, and
+# --clear-hand is on or off, nothing else.
+execute_process(COMMAND "${BENCH}" --embedded-only --placements 8 --seed 4 --methods ours
+  --approaching RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "--approaching exited ${rc}\n${out}\n${err}")
+endif()
+foreach(split all inside clear)
+  if(NOT out MATCHES "\\| mug \\| ours \\| [0-9]+ \\| ${split} \\|")
+    message(FATAL_ERROR "--approaching: no '${split}' line for the mug\n${out}")
+  endif()
+endforeach()
+execute_process(COMMAND "${BENCH}" --embedded-only --placements 1 --methods ours --clear-hand maybe
+  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 2)
+  message(FATAL_ERROR "--clear-hand maybe: exit ${rc}, expected 2 (usage)\n${err}")
+endif()
+
 # 2. A broken file is named and skipped; the good file after it still runs; exit non-zero.
 file(WRITE "${WORK}/broken.obj" "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n")
 file(WRITE "${WORK}/cube.obj" "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\n"

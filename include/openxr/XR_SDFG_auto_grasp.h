@@ -398,6 +398,52 @@ typedef struct XrGraspTargetSettingsSDFG {
 typedef XrResult(XRAPI_PTR* PFN_xrSetGraspTargetSettingsSDFG)(
     XrGraspTargetSDFG target, const XrGraspTargetSettingsSDFG* settings);
 
+// ---- Version 2, continued: never inside (the hand's clearance and offset) ------------------
+// Added after the version 1 structs, which keep their layout: an app built against version 1
+// keeps working and simply does not chain these. Structure types continue in the extension's
+// range at 1009900040.
+#define XR_TYPE_GRASP_HAND_OFFSET_SDFG ((XrStructureType)1009900040)
+#define XR_TYPE_GRASP_CLEARANCE_OPTIONS_SDFG ((XrStructureType)1009900041)
+
+// A three-way switch for options whose zero keeps the layer's default.
+typedef enum XrGraspSwitchSDFG {
+  XR_GRASP_SWITCH_DEFAULT_SDFG = 0,  // the layer's configuration decides
+  XR_GRASP_SWITCH_OFF_SDFG = 1,
+  XR_GRASP_SWITCH_ON_SDFG = 2,
+  XR_GRASP_SWITCH_MAX_ENUM_SDFG = 0x7FFFFFFF
+} XrGraspSwitchSDFG;
+
+// Optional output, chained on XrGraspStateSDFG::next: how far the layer moved the hand off the
+// tracked (or controller-driven) pose so that no part of it is inside the held object. Every one
+// of the 26 joints xrLocateHandJointsEXT returns is moved by `offset`: a joint's shown pose is
+// trackedWrist * offset * (trackedWrist^-1 * jointPose), with trackedWrist the wrist joint as
+// tracked (or as the layer synthesizes it from the grip pose). An app that draws its own
+// controller or arm applies the same `offset` to it in the wrist frame to follow the hand.
+typedef struct XrGraspHandOffsetSDFG {
+  XrStructureType type;  // XR_TYPE_GRASP_HAND_OFFSET_SDFG
+  void* XR_MAY_ALIAS next;
+  XrPosef offset;        // the shown wrist in the tracked wrist's frame (identity: not moved)
+  XrPosef solvedOffset;  // the whole correction of the current grasp; `offset` blends toward it
+                         // at a grab and back to identity after the release
+  float blend;           // 0..1: how much of solvedOffset (or, released, of the last) is shown
+  float openClearance;   // metres: the open hand's smallest part clearance before the correction
+                         // (negative: part of it was inside); 0 when not grasping
+  float displacement;    // metres: largest motion of any part of the hand by solvedOffset
+  XrBool32 exceeded;     // the hand needed more than the bound: it was not moved
+} XrGraspHandOffsetSDFG;
+
+// Optional input, chained on XrGraspOptionsSDFG::next. A zero field keeps the layer's default.
+typedef struct XrGraspClearanceOptionsSDFG {
+  XrStructureType type;  // XR_TYPE_GRASP_CLEARANCE_OPTIONS_SDFG
+  const void* XR_MAY_ALIAS next;
+  XrGraspSwitchSDFG clearance;  // move the open hand out of the object before the fingers close
+  float maxCorrection;          // metres, 0 or (0, 0.2]: a hand that needs more is not moved
+  XrGraspSwitchSDFG approach;   // bring a palm near the surface onto it first
+  float approachRange;          // metres, 0 or (0, 0.2]: palms farther than this are left
+  float approachMaxAngle;       // radians, 0 or (0, pi]: palms turned farther are left
+  float blendTime;              // seconds, 0 or (0, 2]: the offset's blend in and out
+} XrGraspClearanceOptionsSDFG;
+
 #ifdef __cplusplus
 }
 #endif

@@ -77,12 +77,13 @@ std::vector<CapsulePoint> capsule(const HandModel& hand, Finger finger, const Jo
   return out;
 }
 
-// Smallest (sampled value - radius) over the finger's capsule.
+// Smallest (sampled value - radius) over the finger's capsule, in the hand placed by
+// `correction` (GraspResult::handCorrection: where the solver moved the open hand first).
 float capsuleClearance(const SdfGrid& grid, const HandModel& hand, Finger finger,
-                       const JointCurls& curls) {
+                       const JointCurls& curls, const Pose& correction = {}) {
   float best = 1e9f;
   for (const CapsulePoint& c : capsule(hand, finger, curls))
-    best = std::min(best, grid.sample(c.centre) - c.radius);
+    best = std::min(best, grid.sample(correction.transformPoint(c.centre)) - c.radius);
   return best;
 }
 
@@ -261,6 +262,9 @@ TEST_CASE("ours: fingers wrap a cylinder handle, distal joints closing after the
   const SdfGrid grid = analyticGrid(handle, 48);
   const Solved s = solveOurs(grid);
   REQUIRE(s.status == Status::ok);
+  // The bar cuts into the open palm: the hand is moved out first, and every check is made in
+  // the moved hand.
+  const Pose& moved = s.result.handCorrection;
   int wrapped = 0;
   for (Finger f : {Finger::index, Finger::middle, Finger::ring, Finger::little}) {
     const FingerState& st = s.result.fingers[int(f)];
@@ -273,14 +277,16 @@ TEST_CASE("ours: fingers wrap a cylinder handle, distal joints closing after the
       ++wrapped;
       // The wrapped tip is nearer the handle than it was at the first touch (single curl).
       const float a = st.curl;
-      const float singleTip = handle(hand.tipPosition(f, a)) - hand.tipRadius(f);
+      const float singleTip =
+          handle(moved.transformPoint(hand.tipPosition(f, a))) - hand.tipRadius(f);
       std::vector<Pose> poses(fingerJoints(f).size());
       hand.fingerPose(f, st.jointCurls, poses);
-      const float wrappedTip = handle(poses.back().position) - hand.tipRadius(f);
+      const float wrappedTip =
+          handle(moved.transformPoint(poses.back().position)) - hand.tipRadius(f);
       CHECK(wrappedTip < singleTip - 0.005f);
       CHECK(wrappedTip > -1e-3f);
     }
-    CHECK(capsuleClearance(grid, hand, f, st.jointCurls) >= -1e-3f);
+    CHECK(capsuleClearance(grid, hand, f, st.jointCurls, moved) >= -1e-3f);
   }
   CHECK(wrapped >= 3);
 }
@@ -361,6 +367,8 @@ TEST_CASE("approach: the palm moves onto a plane and faces it", "[solver][ours][
   SECTION("the solver applies it when asked") {
     SolverOptions so;
     so.approach = true;
+    // The approach alone (the clearance after it has its own tests, hand_clearance.tests.cpp).
+    so.clearance = false;
     const Solved s = solveOurs(grid, so);
     REQUIRE(s.status == Status::ok);
     CHECK(glm::length(s.result.handCorrection.position - r->handCorrection.position) < 1e-5f);

@@ -31,6 +31,12 @@ const char* const kUsage =
     "                     exact everywhere)\n"
     "  --thin-plate-set   only the embedded thin plate, graded on the placements where\n"
     "                     \"paper\" (added if missing; --da must be 0.1) passes through it\n"
+    "  --approaching      approaching hands: the palm from 1 cm inside to 5 cm outside the\n"
+    "                     surface, open hands inside the mesh kept; adds the table of the whole\n"
+    "                     hand's penetration, the hand's motion and contacts, split by whether\n"
+    "                     the open hand was already inside\n"
+    "  --clear-hand on|off  on (default): \"ours\" moves an open hand that is inside the mesh\n"
+    "                     out before closing (SolverOptions::clearance); off: as before\n"
     "  --json FILE        write the results as JSON\n"
     "  --report DIR       also write DIR/benchmarks.md with tables and plots (gnuplot) of this\n"
     "                     run, DIR/img/bench/*.png and DIR/bench-data/; implies --scaling\n"
@@ -118,6 +124,8 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
       o.embeddedOnly = true;
     } else if (arg == "--thin-plate-set") {
       o.thinPlateSet = true;
+    } else if (arg == "--approaching") {
+      o.approaching = true;
     } else if (arg == "--mesh") {
       if (auto e = needValue(v)) return e;
       o.meshes.push_back(v);
@@ -156,6 +164,11 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
       if (v != "on" && v != "off")
         return UsageError{"--exact-check: \"" + v + "\" is not on or off"};
       o.exactCheck = v == "on";
+    } else if (arg == "--clear-hand") {
+      if (auto e = needValue(v)) return e;
+      if (v != "on" && v != "off")
+        return UsageError{"--clear-hand: \"" + v + "\" is not on or off"};
+      o.clearHand = v == "on";
     } else if (arg == "--threads") {
       if (auto e = needValue(v)) return e;
       if (!parseInt(v, 0, 1024, n)) return UsageError{"--threads: \"" + v + "\" is not 0..1024"};

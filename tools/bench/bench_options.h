@@ -20,6 +20,10 @@ struct Options {
   bool embedded = false;
   bool embeddedOnly = false;
   bool thinPlateSet = false;
+  // --approaching: placements from 1 cm inside to 5 cm outside (eval/approaching.h), and the
+  // table split by whether the open hand was already inside.
+  bool approaching = false;
+  bool clearHand = true;  // --clear-hand: "ours" clears the open hand before closing
   int placements = 1000;
   uint64_t seed = 1;
   std::vector<std::string> methods;

@@ -13,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "approaching_table.h"
 #include "bench_options.h"
 #include "bench_output.h"
 #include "io/mesh_io.h"
@@ -146,6 +147,12 @@ int main(int argc, char** argv) {
   }
 
   printTables(o, rows);
+  if (o.approaching) {
+    std::printf(
+        "\nApproaching hands (palm 1 cm inside to 5 cm outside), split by whether the "
+        "open hand was already inside:\n\n");
+    printApproachingTable(stdout, rows);
+  }
   if (!o.report.empty() && o.json.empty()) o.json = bench::reportResultsPath(o.report).string();
   if (!o.json.empty() && !writeJson(o.json, o, rows)) {
     std::fprintf(stderr, "autograsp-bench: cannot write %s\n", o.json.c_str());

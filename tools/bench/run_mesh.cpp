@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "eval/approaching.h"
 #include "eval/evaluator.h"
 #include "eval/placements.h"
 #include "eval/solver_physics.h"
@@ -33,6 +34,26 @@
 
 namespace sdfg::bench {
 namespace {
+
+// --approaching: the approaching placements (eval/approaching.h), with openInside[p] set for
+// each; `stats` counts them as drawn (none is rejected for touching the mesh).
+std::vector<Placement> approachingPlacements(const TriangleMesh& mesh, const ExactMeshQuery& exact,
+                                             const HandModel& hand, const GridBox& box,
+                                             const Options& o, std::vector<char>& openInside,
+                                             PlacementStats& stats) {
+  const std::vector<ApproachPlacement> drawn =
+      generateApproachingPlacements(mesh, exact, hand, box, o.placements, o.seed);
+  std::vector<Placement> out;
+  openInside.clear();
+  for (const ApproachPlacement& a : drawn) {
+    out.push_back(a.placement);
+    openInside.push_back(a.openInside ? 1 : 0);
+  }
+  stats = PlacementStats{};
+  stats.attempts = (long long)drawn.size();
+  stats.handIntersecting = (long long)std::count(openInside.begin(), openInside.end(), char(1));
+  return out;
+}
 
 constexpr float kHandSizeDiagonal = 0.18f;  // metres: every object is scaled to this bbox diagonal
 constexpr double kSolveBatchTargetUs = 50.0;  // a timed batch lasts at least this long
@@ -159,6 +180,7 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
   bool anyField = false;
   SolverOptions solverOptions;
   solverOptions.da = o.da;
+  solverOptions.clearance = o.clearHand;
   for (const std::string& m : o.methods) {
     auto solver = createAnySolver(m);
     if (!solver) return solver.error();
@@ -184,8 +206,12 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
   auto now = [] { return std::chrono::steady_clock::now(); };
   const auto startedAt = now();
   PlacementStats placementStats;
+  // --approaching: the open hand may already be inside; openInside[p] says so.
+  std::vector<char> openInside;
   const std::vector<Placement> placements =
-      generatePlacements(mesh, **exact, hand, box, o.placements, o.seed, &placementStats);
+      o.approaching
+          ? approachingPlacements(mesh, **exact, hand, box, o, openInside, placementStats)
+          : generatePlacements(mesh, **exact, hand, box, o.placements, o.seed, &placementStats);
   std::fprintf(stderr,
                "%s: %zu placements from %lld attempts (%lld outside the box, %lld with the open "
                "hand touching the mesh)\n",
@@ -273,11 +299,16 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
 
   const auto solvedAt = now();
   std::vector<GraspMetrics> metrics(rows.size() * placements.size());
+  std::vector<float> handPenetration(o.approaching ? metrics.size() : 0, 0.0f);
   std::atomic<size_t> graded{0};
   parallelFor(metrics.size(), threads, [&](size_t i) {
     const size_t m = i / placements.size(), p = i % placements.size();
     if (solved[m][p]) {
       metrics[i] = evaluateGrasp(**exact, hand, placements[p].objectFromHand, results[m][p]);
+      if (o.approaching) {
+        handPenetration[i] =
+            graspPenetrationMm(**exact, hand, placements[p].objectFromHand, results[m][p]);
+      }
     }
     const size_t g = ++graded;
     if (g % 16 == 0) progress.show(name, "grade", g, metrics.size());
@@ -312,6 +343,13 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
       row.earlyStops += g.earlyStops;
       row.contacts += g.contacts;
       row.passThroughs += g.passThroughs;
+      if (o.approaching) {
+        row.handPenetrationMm.push_back(handPenetration[m * placements.size() + p]);
+        row.handMovedMm.push_back(results[m][p].handMoved * 1000.0);
+        row.openInside.push_back(openInside[p]);
+        row.graspContacts.push_back(g.contacts);
+        row.pastBound.push_back(results[m][p].clearanceExceeded ? 1 : 0);
+      }
       for (int f = 0; f < kFingerCount; ++f) {
         const FingerMetrics& fm = g.fingers[f];
         if (!fm.contact) continue;

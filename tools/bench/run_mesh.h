@@ -47,6 +47,14 @@ struct Row {
   std::vector<double> penetrationMm;                        // per grasp: deepest phalanx point
   int earlyStops = 0;
   long long contacts = 0;
+  // --approaching, per grasp: the whole hand's deepest point inside (eval/approaching.h), how
+  // far the strategy moved the hand (GraspResult::handMoved), mm; whether the open hand was
+  // already inside; fingers touching.
+  std::vector<double> handPenetrationMm;
+  std::vector<double> handMovedMm;
+  std::vector<char> openInside;
+  std::vector<int> graspContacts;
+  std::vector<char> pastBound;  // the hand needed more than the clearance's bound: not moved
 
   double contactsMean() const { return grasps > 0 ? double(contacts) / grasps : std::nan(""); }
 };

@@ -196,6 +196,29 @@ void exactFinger(const HandPose& hand, int f, const MeshDistance& distance,
   row.clearanceMm = least * 1000.0f;
 }
 
+// Least exact clearance of the whole hand, mm (negative: inside): the palm's sphere and every
+// bone's capsule from the metacarpal joint to the tip, radii interpolated between the joints.
+float wholeHandClearanceMm(const HandPose& hand, const MeshDistance& distance,
+                           const Pose& objectFromWorld) {
+  auto d = [&](const glm::vec3& p) {
+    return distance.signedDistance(objectFromWorld.transformPoint(p));
+  };
+  const size_t palm = size_t(Joint::palm);
+  float least = d(hand.positions[palm]) - hand.radii[palm];
+  for (int f = 0; f < kFingerCount; ++f) {
+    const auto joints = fingerJoints(Finger(f));
+    for (size_t j = 0; j + 1 < joints.size(); ++j) {
+      const size_t a = size_t(joints[j]), b = size_t(joints[j + 1]);
+      for (int s = 0; s <= 8; ++s) {
+        const float t = float(s) / 8.0f;
+        least = std::min(least, d(glm::mix(hand.positions[a], hand.positions[b], t)) -
+                                    glm::mix(hand.radii[a], hand.radii[b], t));
+      }
+    }
+  }
+  return least * 1000.0f;
+}
+
 HandPose handFromJoints(const HandJoints& j) {
   HandPose h;
   for (int k = 0; k < kJointCount; ++k) {
@@ -346,6 +369,9 @@ int main(int argc, char** argv) {
           panel.contacts.push_back(worldFromObject.transformPoint({p.x, p.y, p.z}));
         }
       }
+      sr.wholeHandMm = wholeHandClearanceMm(panel.hand, **distance, objectFromWorld);
+      sr.handMovedMm = r.grasped ? r.offset.displacement * 1000.0f : 0.0f;
+      sr.openClearanceMm = r.grasped ? r.offset.openClearance * 1000.0f : 0.0f;
       if (!sr.ok) anyFailure = true;
       layerResults.push_back(sr);
     }
@@ -406,6 +432,7 @@ int main(int argc, char** argv) {
           panel.contacts.push_back(worldFromWrist.transformPoint(gr.fingers[f].contactPoint));
         }
       }
+      phys.wholeHandMm = wholeHandClearanceMm(panel.hand, **distance, objectFromWorld);
       if (!phys.ok) anyFailure = true;
     }
     result.strategies = {phys, layerResults[0], layerResults[1]};

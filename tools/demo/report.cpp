@@ -18,6 +18,9 @@ std::string num(float v, int decimals) {
   return buf;
 }
 
+// HTML text from the report's Markdown-style text: escaped, with `code` spans as <code>.
+std::string inlineHtml(const std::string& s);
+
 std::string escape(const std::string& s) {
   std::string out;
   for (char c : s) {
@@ -30,6 +33,24 @@ std::string escape(const std::string& s) {
     else
       out += c;
   }
+  return out;
+}
+
+std::string inlineHtml(const std::string& s) {
+  std::string out;
+  bool code = false;
+  for (char c : s) {
+    if (c == '`') {
+      out += code ? "</code>" : "<code>";
+      code = !code;
+    } else {
+      out += escape(std::string(1, c));
+    }
+  }
+  if (code) out += "</code>";
+  // A blank line is a paragraph break, as in the Markdown (callers wrap the text in <p>).
+  for (size_t at = out.find("\n\n"); at != std::string::npos; at = out.find("\n\n", at))
+    out.replace(at, 2, "</p>\n<p>");
   return out;
 }
 
@@ -73,8 +94,15 @@ std::string summaryLine(const StrategyResult& s) {
   }
   float worst = 1e9f;
   for (const auto& f : s.fingers) worst = std::min(worst, f.clearanceMm);
-  line << s.contacts << " fingers in contact, deepest point " << num(-std::min(worst, 0.0f), 1)
-       << " mm inside";
+  line << s.contacts << " fingers in contact, deepest finger point "
+       << num(std::max(0.0f, -worst), 1) << " mm inside; whole hand "
+       << (s.wholeHandMm >= 0.0f ? "clear (" + num(s.wholeHandMm, 2) + " mm)"
+                                 : num(-s.wholeHandMm, 2) + " mm inside");
+  if (s.source == "layer") {
+    line << "; hand moved " << num(s.handMovedMm, 1) << " mm off the controller pose";
+    if (s.openClearanceMm < 0.0f)
+      line << " (the open hand was " << num(-s.openClearanceMm, 1) << " mm inside)";
+  }
   if (s.source == "layer")
     line << ", grasp after " << s.frames << " frames (" << num(float(s.milliseconds), 1) << " ms)";
   else
@@ -97,7 +125,10 @@ const char* kExplain =
     "distance: what the strategy saw at its contact (SDF or Bullet); tip gap: exact distance "
     "of the fingertip sphere to the mesh (negative: inside); least clearance: the same for the "
     "whole finger (capsules of the joint radii), so a negative value is a finger through the "
-    "object.";
+    "object. Each strategy's line gives the whole hand's least clearance (palm, metacarpals "
+    "and phalanges) and, for the layer's strategies, how far the layer moved the hand off the "
+    "controller pose to clear the open hand before closing it (`XrGraspHandOffsetSDFG`; `ours` "
+    "only).";
 
 }  // namespace
 
@@ -113,11 +144,20 @@ bool writeReports(const std::string& dir, const std::vector<ObjectResult>& objec
   md << "Runtime: " << info.runtime << "; Vulkan device: " << info.device << "; "
      << info.environment << "; panel width " << info.width << " px.\n\n";
   html << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>SDF Autograsp demo</title>"
-       << "<style>body{font-family:sans-serif;max-width:1600px;margin:auto;background:#fafafa}"
-       << "img{max-width:100%;border:1px solid #ccc}table{border-collapse:collapse;margin:8px 0}"
+       << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
+       // Pictures and tables shrink to the page (a picture row is three panels wide), text is
+       // set at a readable measure, and code spans look like code.
+       << "<style>body{font-family:sans-serif;max-width:1200px;margin:auto;padding:0 16px;"
+       << "background:#fafafa;line-height:1.45;color:#222}p,li{max-width:80ch}"
+       << "img{display:block;max-width:100%;height:auto;border:1px solid #ccc}"
+       << "img.slice{max-width:min(100%,512px)}.scroll{overflow-x:auto}"
+       << "table{border-collapse:collapse;margin:8px 0;font-size:0.9em}"
        << "td,th{border:1px solid #bbb;padding:2px 8px;text-align:right}"
-       << "td:first-child,td:nth-child(2){text-align:left}.fail{color:#b00}</style></head><body>\n"
-       << "<h1>SDF Autograsp demo</h1>\n<p>" << escape(kExplain)
+       << "th{background:#eee}td:first-child,td:nth-child(2),th:first-child,th:nth-child(2)"
+       << "{text-align:left}.caption{font-size:0.85em;color:#555}"
+       << "code{font-family:monospace;background:#eee;padding:0 3px;border-radius:3px}"
+       << ".fail{color:#b00}</style></head><body>\n"
+       << "<h1>SDF Autograsp demo</h1>\n<p>" << inlineHtml(kExplain)
        << "</p>\n<p>Runtime: " << escape(info.runtime) << "; Vulkan device: " << escape(info.device)
        << "; " << escape(info.environment) << "; panel width " << info.width << " px.</p>\n";
   if (!info.failures.empty()) {
@@ -136,14 +176,16 @@ bool writeReports(const std::string& dir, const std::vector<ObjectResult>& objec
     md << "![" << o.name << ": grab-box SDF slice](" << o.slicePng << ")\n\n";
     html << "<h2>" << escape(o.name) << "</h2>\n<p>" << escape(o.origin) << ", " << o.triangles
          << " triangles.</p>\n<p><img src=\"" << o.graspPng << "\" alt=\"" << escape(o.name)
-         << ": physics-convex, paper, ours\"></p>\n<p><img src=\"" << o.slicePng
-         << "\" alt=\"grab-box SDF slice\" style=\"max-width:512px\"></p>\n<ul>\n";
+         << ": physics-convex, paper, ours\">\n<span class=\"caption\">left to right: "
+         << "<code>physics-convex</code>, <code>paper</code>, <code>ours</code></span></p>\n"
+         << "<p><img src=\"" << o.slicePng
+         << "\" alt=\"grab-box SDF slice\" class=\"slice\"></p>\n<ul>\n";
     for (const auto& s : o.strategies) {
       md << "- " << summaryLine(s) << "\n";
-      html << "<li>" << escape(summaryLine(s)) << "</li>\n";
+      html << "<li>" << inlineHtml(summaryLine(s)) << "</li>\n";
     }
     md << "\n|";
-    html << "</ul>\n<table><tr>";
+    html << "</ul>\n<div class=\"scroll\"><table><tr>";
     for (const auto& h : header()) {
       md << " " << h << " |";
       html << "<th>" << escape(h) << "</th>";
@@ -163,7 +205,7 @@ bool writeReports(const std::string& dir, const std::vector<ObjectResult>& objec
       html << "</tr>\n";
     }
     md << "\n";
-    html << "</table>\n";
+    html << "</table></div>\n";
   }
   html << "</body></html>\n";
   if (!md || !html) {

@@ -24,6 +24,12 @@ struct StrategyResult {
   std::string error;
   std::array<FingerRow, 5> fingers{};
   int contacts = 0;
+  // The whole hand (palm, metacarpals, phalanges: capsules of the joint radii): least exact
+  // clearance, mm (negative: inside); how far the layer moved the hand off the controller pose
+  // (XrGraspHandOffsetSDFG), mm; and the open hand's clearance before it did, mm.
+  float wholeHandMm = 0.0f;
+  float handMovedMm = 0.0f;
+  float openClearanceMm = 0.0f;
   int frames = 0;           // frames from the squeeze to the reported grasp (layer)
   double milliseconds = 0;  // that time, or the solve time (core)
 };

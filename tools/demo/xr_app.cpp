@@ -339,11 +339,16 @@ bool XrApp::locate(HandJoints& out) {
   return true;
 }
 
-bool XrApp::graspState(XrGraspStateSDFG& out, XrGraspBuildInfoSDFG* build) {
+bool XrApp::graspState(XrGraspStateSDFG& out, XrGraspBuildInfoSDFG* build,
+                       XrGraspHandOffsetSDFG* offset) {
   XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
   out = XrGraspStateSDFG{XR_TYPE_GRASP_STATE_SDFG};
+  if (offset != nullptr) {
+    *offset = XrGraspHandOffsetSDFG{XR_TYPE_GRASP_HAND_OFFSET_SDFG};
+    out.next = offset;
+  }
   if (build != nullptr) {
-    *build = XrGraspBuildInfoSDFG{XR_TYPE_GRASP_BUILD_INFO_SDFG};
+    *build = XrGraspBuildInfoSDFG{XR_TYPE_GRASP_BUILD_INFO_SDFG, out.next};
     out.next = build;
   }
   const bool ok = getState_(session_, &gi, &out) == XR_SUCCESS;
@@ -419,18 +424,25 @@ GraspReading XrApp::grasp(XrGraspTargetSDFG target, const XrPosef& grip, XrGrasp
   }
   out.milliseconds =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  // The solved pose is applied from the next locate after the grasp is reported.
+  // The solved pose is applied from the next locate after the grasp is reported; a hand moved
+  // out of the object blends there over a few frames (offset_blend_time): wait for all of it.
   frame();
+  for (int i = 0; i < 240 && out.grasped; ++i) {
+    if (graspState(st, nullptr, &out.offset) && (out.offset.blend >= 1.0f || !st.isGrasping)) break;
+    frame();
+  }
   if (!locate(out.joints)) out.error = "xrLocateHandJointsEXT: the right hand is not active";
-  graspState(out.state);
+  graspState(out.state, nullptr, &out.offset);
+  out.state.next = nullptr;
   if (!out.grasped && out.error.empty())
     out.error = "the layer reported no grasp within 10 s (is the object in the grab box?)";
   // Let go and wait until the hand is open again, so the next grab starts afresh.
   const uint64_t g = framesEnded_;
   script(gripLine(g, grip) + squeezeLine(g, 0.0f));
-  for (int i = 0; i < 20; ++i) {
+  XrGraspHandOffsetSDFG offset{XR_TYPE_GRASP_HAND_OFFSET_SDFG};
+  for (int i = 0; i < 240; ++i) {
     frame();
-    if (graspState(st) && !st.isGrasping) break;
+    if (graspState(st, nullptr, &offset) && !st.isGrasping && offset.blend <= 0.0f) break;
   }
   return out;
 }

@@ -37,6 +37,9 @@ struct GraspReading {
   HandJoints joints;      // xrLocateHandJointsEXT after the grasp was applied
   HandJoints openJoints;  // the same hand before the squeeze (where the hand was placed)
   XrGraspStateSDFG state{XR_TYPE_GRASP_STATE_SDFG};
+  // The hand's offset off the controller pose when `joints` were read (blended in fully): how
+  // far the layer moved the open hand out of the object before closing it.
+  XrGraspHandOffsetSDFG offset{XR_TYPE_GRASP_HAND_OFFSET_SDFG};
   int frames = 0;  // frames from the squeeze to the reported grasp
   double milliseconds = 0.0;
   std::string error;  // why it failed, when it did
@@ -84,8 +87,10 @@ class XrApp {
   void pollEvents();
   void frame();
   bool locate(HandJoints& out);
-  // `build`, when given, receives where the SDF was built (chained XrGraspBuildInfoSDFG).
-  bool graspState(XrGraspStateSDFG& out, XrGraspBuildInfoSDFG* build = nullptr);
+  // `build`, when given, receives where the SDF was built (chained XrGraspBuildInfoSDFG);
+  // `offset` the hand's offset off the controller pose (chained XrGraspHandOffsetSDFG).
+  bool graspState(XrGraspStateSDFG& out, XrGraspBuildInfoSDFG* build = nullptr,
+                  XrGraspHandOffsetSDFG* offset = nullptr);
   bool script(const std::string& text);
 
   XrInstance instance_ = XR_NULL_HANDLE;

@@ -308,6 +308,8 @@ void GraspSession::post(HandState& hand, size_t slot, uint64_t id, const Pose& o
                         std::optional<SdfGrid> field, bool gpu, int64_t time) {
   GraspWorker::Job job;
   job.time = time;
+  job.extraParts = hand.trackedParts;
+  job.extraPartCount = hand.trackedPartCount;
   job.ticket = ++hand.ticket;
   job.target = id;
   job.objectFromHand = objectFromHand;
@@ -384,10 +386,22 @@ Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Targ
                        hand.frameTime);
 }
 
+void GraspSession::noteTrackedParts(HandState& hand, const HandFrame& frame) {
+  hand.trackedPartCount = 0;
+  if (!frame.valid || frame.trackedJoints == nullptr || frame.trackedRadii == nullptr) return;
+  const Pose wristFromWorld = frame.worldFromWrist.inverse();
+  JointPoses local;
+  for (int j = 0; j < kJointCount; ++j)
+    local[size_t(j)] = wristFromWorld * (*frame.trackedJoints)[size_t(j)];
+  hand.trackedPartCount = jointParts(local, *frame.trackedRadii, hand.trackedParts);
+}
+
 Status GraspSession::solveWithGrid(HandState& hand, const Pose& objectFromHand, uint64_t version,
                                    bool gpu, const MeshDistance* exactMesh, int64_t time) {
   GraspScene scene;
   scene.field = &hand.grid;
+  scene.extraParts =
+      std::span<const HandPart>(hand.trackedParts.data(), size_t(hand.trackedPartCount));
   scene.objectFromHand = objectFromHand;
   std::optional<MeshExactSource> exact;
   if (settings_.exactCheck && exactMesh != nullptr) {
@@ -484,6 +498,7 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
             settings_.turnTolerance;
     if (hand.grasp.solves > 0 && !moved && hand.solvedVersion == it->second.version)
       return collected;
+    noteTrackedParts(hand, frame);
     const Status s = solve(hand, slot, it->first, it->second, objectFromHand);
     if (s != Status::ok) {
       cancelPending(hand, slot);
@@ -511,6 +526,7 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   hand.grasp = HandGrasp{};
   hand.grasp.holding = true;
   hand.grasp.target = *id;
+  noteTrackedParts(hand, frame);
   const Pose objectFromHand = located->worldFromObject.inverse() * frame.worldFromWrist;
   hand.objectFromHandNow = objectFromHand;
   const Status s = solve(hand, slot, *id, target, objectFromHand);

@@ -41,6 +41,7 @@
 #include "base/status.h"
 #include "grasp/contact.h"
 #include "grasp/grasp_worker.h"
+#include "grasp/hand_clearance.h"
 #include "grasp/solver.h"
 #include "hand/hand_model.h"
 #include "mesh/mesh.h"
@@ -237,7 +238,13 @@ class GraspSession {
     uint64_t pendingVersion = 0;
     int64_t pendingTime = 0;
     int64_t frameTime = 0;  // HandFrame::time of the update in progress
+    // A tracked hand's open-hand parts as the user holds it (wrist frame), cleared besides the
+    // model's open hand (GraspScene::extraParts); 0 for a controller-driven hand.
+    HandParts trackedParts{};
+    int trackedPartCount = 0;
   };
+  // Sets hand.trackedParts from the frame's tracked joints (none: count 0). Before a solve.
+  static void noteTrackedParts(HandState& hand, const HandFrame& frame);
 
   Status solve(HandState& hand, size_t slot, uint64_t id, const Target& target,
                const Pose& objectFromHand);

@@ -316,6 +316,8 @@ void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job jo
       scene.field = field;
       scene.objectFromHand = job.objectFromHand;
       scene.fieldFromHand = fieldFromHand;
+      scene.extraParts =
+          std::span<const HandPart>(job.extraParts.data(), size_t(job.extraPartCount));
       std::optional<MeshExactSource> exact;
       if (job.exactCheck && distance != nullptr) {
         exact.emplace(*distance, job.objectFromHand);

@@ -37,6 +37,7 @@
 #include "base/pose.h"
 #include "base/status.h"
 #include "grasp/contact.h"
+#include "grasp/hand_clearance.h"
 #include "grasp/solver.h"
 #include "hand/hand_model.h"
 #include "mesh/mesh.h"
@@ -90,6 +91,9 @@ class GraspWorker {
     // A field built elsewhere (the GPU): solve on it, build nothing.
     std::optional<SdfGrid> field;
     int64_t time = 0;  // the frame time the hand and target poses belong to, echoed in Done
+    // A tracked hand's open-hand parts to clear besides the model's (GraspScene::extraParts).
+    HandParts extraParts{};
+    int extraPartCount = 0;
   };
 
   struct Done {

@@ -49,6 +49,18 @@ std::optional<Error> validateSolverOptions(const SolverOptions& options) {
     return makeError(Status::invalid_argument,
                      "solver options: threshold must be finite (negative: the tip radius)");
   }
+  if (!(options.approachRange > 0.0f) || !(options.approachMaxAngle > 0.0f) ||
+      !std::isfinite(options.approachMaxAngle)) {
+    return makeError(Status::invalid_argument,
+                     "solver options: approachRange must be > 0 (infinity: any distance) and "
+                     "approachMaxAngle finite and > 0");
+  }
+  if (!(options.clearanceBound >= 0.0f) || !std::isfinite(options.clearanceBound) ||
+      !(options.clearanceMargin >= 0.0f) || !(options.clearanceMargin <= 0.01f)) {
+    return makeError(Status::invalid_argument,
+                     "solver options: clearanceBound must be finite and >= 0, clearanceMargin "
+                     "in [0, 0.01]");
+  }
   return std::nullopt;
 }
 

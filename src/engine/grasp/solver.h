@@ -28,12 +28,24 @@ namespace sdfg {
 
 class PhysicsCollider;  // solver_physics.h
 class MeshDistance;     // mesh_distance.h
+struct HandPart;        // hand_clearance.h
 
 struct SolverOptions {
   float da = 0.1f;           // curl step along each finger's curve, in (0, 1]
   float threshold = -1.0f;   // stop distance in metres; < 0: each finger's tip radius
   float refineStep = 0.01f;  // physics strategies: the fine step after the coarse one
   bool approach = false;     // "ours": move the hand onto the surface first (approachPose)
+  // "ours", with approach: only when the palm is this close to the surface (metres; infinity:
+  // any distance), not touching it, and facing it within approachMaxAngle (radians).
+  float approachRange = std::numeric_limits<float>::infinity();
+  float approachMaxAngle = 3.1416f;
+  // "ours": before the fingers close, move the open hand out of the target by the smallest
+  // rigid correction (grasp/hand_clearance.h), up to clearanceBound metres of motion; a hand
+  // that needs more is not moved. clearanceMargin: the clearance every part ends with.
+  bool clearance = true;
+  float clearanceBound = 0.03f;
+  float clearanceMargin = 0.0005f;
+  bool clearanceRotation = true;  // a turn about the palm where it moves the hand less
 };
 
 struct FingerState {
@@ -61,6 +73,13 @@ struct GraspResult {
   // the wall time of that check (included in the solve), microseconds. 0 without a source.
   int exactSamples = 0;
   float exactCheckUs = 0.0f;
+  // The open hand's clearance (SolverOptions::clearance; "ours"): its smallest part clearance
+  // (distance - radius, metres) before any correction, how far the correction moved the most
+  // moved part (metres; includes the approach), and whether a correction within the bound
+  // could not clear it (then the hand was left where it was).
+  float openClearance = std::numeric_limits<float>::infinity();
+  float handMoved = 0.0f;
+  bool clearanceExceeded = false;
 };
 
 // One exact sample of the target's distance (ExactDistanceSource).
@@ -121,6 +140,10 @@ struct GraspScene {
   // build; the caller must make sure the box still covers the fingers there. Other strategies
   // need identity.
   Pose fieldFromHand{};
+  // More parts of the open hand to clear before closing (SolverOptions::clearance), hand space of
+  // the scene: a tracked hand as the user holds it, which can differ from the model's open pose
+  // by centimetres. Empty: the model's open hand alone. The caller owns the parts.
+  std::span<const HandPart> extraParts{};
 };
 
 class GraspSolver {

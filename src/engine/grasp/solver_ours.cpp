@@ -89,10 +89,15 @@ Status OursSolver::prepare(const HandModel& hand, const GridBox& box,
     auto radiusAt = [&](int bone, float t) {
       return (1.0f - t) * hand.jointRadius(joints[bone]) + t * hand.jointRadius(joints[bone + 1]);
     };
+    // The thumb's metacarpal turns at its carpometacarpal joint as the hand closes (the other
+    // metacarpals are fixed): its whole capsule sweeps toward the palm, so it is sampled along
+    // its length like a phalanx, not only at its end joint.
+    const bool movingMetacarpal = fr.rig[0].angle > 1e-4f;
+    const int firstBone = movingMetacarpal ? 0 : 1;
     float spacing = kSphereSpacing;
     for (int attempt = 0; attempt < 8; ++attempt) {
-      int count = 1;
-      for (int b = 1; b < n; ++b) {
+      int count = movingMetacarpal ? 0 : 1;
+      for (int b = firstBone; b < n; ++b) {
         const float r = std::min(hand.jointRadius(joints[b]), hand.jointRadius(joints[b + 1]));
         count += std::max(1, int(std::ceil(boneLength[b] / (spacing * std::max(r, 1e-4f)))));
       }
@@ -109,12 +114,12 @@ Status OursSolver::prepare(const HandModel& hand, const GridBox& box,
       s.radius = radiusAt(bone, t);
       s.testRadius = s.radius + cover + thresholdOffset;
     };
-    {
+    if (!movingMetacarpal) {
       const float r = hand.jointRadius(joints[1]);
       const float s = spacing * r;
       addSphere(0, 1.0f, std::sqrt(r * r + 0.25f * s * s) - r);
     }
-    for (int b = 1; b < n; ++b) {
+    for (int b = firstBone; b < n; ++b) {
       const float r =
           std::max(1e-4f, std::min(hand.jointRadius(joints[b]), hand.jointRadius(joints[b + 1])));
       const int count = std::max(1, int(std::ceil(boneLength[b] / (spacing * r))));
@@ -171,6 +176,12 @@ Status OursSolver::prepare(const HandModel& hand, const GridBox& box,
       if (glm::length(p - pa[n].position) > kKinematicsTolerance) fr.ownKinematics = false;
     }
   }
+  partCount_ = handParts(hand, FingerCurls{}, parts_);
+  {
+    JointPoses open{};
+    hand.pose(FingerCurls{}, open);
+    palm_ = open[size_t(Joint::palm)].position;
+  }
   prepared_ = true;
   return Status::ok;
 }
@@ -206,9 +217,58 @@ Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {
   }
 
   out = GraspResult{};
+  bool approached = false;
   if (options_.approach) {
-    Result<ApproachResult> approach = approachPose(field, hand_);
-    if (approach.ok()) out.handCorrection = approach->handCorrection;
+    // Only a palm near the surface, not touching it and roughly facing it is brought onto it:
+    // a hand far away or turned away is not reaching for this surface.
+    const float d = field.sample(palm_);
+    const glm::vec3 g = field.gradient(palm_);
+    JointPoses open{};
+    hand_.pose(FingerCurls{}, open);
+    const glm::vec3 palmNormal =
+        open[size_t(Joint::palm)].transformVector(glm::vec3(0.0f, -1.0f, 0.0f));
+    const float gl = glm::length(g);
+    const float facing =
+        gl > 1e-3f ? std::acos(std::clamp(glm::dot(palmNormal, -g / gl), -1.0f, 1.0f)) : 0.0f;
+    if (gl > 1e-3f && d > hand_.jointRadius(Joint::palm) && d <= options_.approachRange &&
+        facing <= options_.approachMaxAngle) {
+      Result<ApproachResult> approach = approachPose(field, hand_);
+      if (approach.ok()) out.handCorrection = approach->handCorrection, approached = true;
+    }
+  }
+  if (options_.clearance) {
+    ClearanceOptions co;
+    co.margin = options_.clearanceMargin;
+    co.maxCorrection = options_.clearanceBound;
+    co.rotation = options_.clearanceRotation;
+    co.fieldFromHand = scene.fieldFromHand;
+    // The model's open hand (where the fingers close from), and the scene's own parts of the
+    // hand (a tracked hand as the user holds it), cleared together.
+    HandParts all;
+    int count = 0;
+    for (int i = 0; i < partCount_ && count < kMaxHandParts; ++i) all[size_t(count++)] = parts_[i];
+    for (const HandPart& p : scene.extraParts) {
+      if (count < kMaxHandParts) all[size_t(count++)] = p;
+    }
+    const std::span<const HandPart> parts(all.data(), size_t(count));
+    Result<ClearanceResult> c =
+        clearHand(parts, palm_, &field, scene.exact, co, out.handCorrection);
+    if (c.ok() && c->exceeded && approached) {
+      // The approach put the hand where it cannot be cleared: clear it from where it was.
+      out.handCorrection = Pose{};
+      c = clearHand(parts, palm_, &field, scene.exact, co, Pose{});
+    }
+    if (c.ok()) {
+      out.openClearance = c->clearanceBefore;
+      out.handCorrection = c->handCorrection;
+      out.clearanceExceeded = c->exceeded;
+      out.exactSamples += c->exactSamples;
+    }
+  }
+  for (int i = 0; i < partCount_; ++i) {
+    out.handMoved = std::max(
+        out.handMoved,
+        glm::length(out.handCorrection.transformPoint(parts_[i].centre) - parts_[i].centre));
   }
   glm::mat3 toBox;
   glm::vec3 toBoxOffset;

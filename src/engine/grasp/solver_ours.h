@@ -29,6 +29,10 @@
 //   taken without sampling it again, which saves about a fifth of the samples.
 // - Approach (optional, SolverOptions::approach): approachPose() follows the field's gradient
 //   from the palm to turn and move the hand onto the surface before the fingers close.
+// - Never inside (SolverOptions::clearance, on by default): an open hand with any part inside
+//   the target is first moved out by the smallest rigid correction (clearHand(),
+//   hand_clearance.h), then the fingers close from there. The thumb's metacarpal, which turns
+//   as the hand closes, is sampled along its length like a phalanx.
 //
 // Holding a moving or deforming target lives in grasp_holder.h. solve() never allocates.
 #pragma once
@@ -43,6 +47,7 @@
 
 #include "base/pose.h"
 #include "base/status.h"
+#include "grasp/hand_clearance.h"
 #include "grasp/solver.h"
 #include "hand/hand_model.h"
 #include "sdf/sdf_grid.h"
@@ -143,6 +148,10 @@ class OursSolver final : public GraspSolver {
                   int& samples) const;
 
   HandModel hand_{};
+  // The open hand's parts and its palm, for the clearance before the fingers close.
+  HandParts parts_{};
+  int partCount_ = 0;
+  glm::vec3 palm_{0.0f};
   GridBox box_{};
   SolverOptions options_{};
   bool prepared_ = false;

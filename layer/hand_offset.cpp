@@ -1,0 +1,120 @@
+// The hand's offset off its tracked pose: blend, joints, report and options (hand_offset.h).
+#include "hand_offset.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "log.h"
+#include "state.h"
+
+namespace sdfg::layer {
+
+void ClearanceRequest::apply(GraspSettings& settings, float& blendTime) const {
+  if (!present) return;
+  const XrGraspClearanceOptionsSDFG& o = options;
+  SolverOptions& so = settings.solverOptions;
+  if (o.clearance != XR_GRASP_SWITCH_DEFAULT_SDFG)
+    so.clearance = o.clearance == XR_GRASP_SWITCH_ON_SDFG;
+  if (o.maxCorrection != 0.0f) so.clearanceBound = o.maxCorrection;
+  if (o.approach != XR_GRASP_SWITCH_DEFAULT_SDFG)
+    so.approach = o.approach == XR_GRASP_SWITCH_ON_SDFG;
+  if (o.approachRange != 0.0f) so.approachRange = o.approachRange;
+  if (o.approachMaxAngle != 0.0f) so.approachMaxAngle = o.approachMaxAngle;
+  if (o.blendTime != 0.0f) blendTime = o.blendTime;
+}
+
+void advanceHandOffset(SessionState& s, int h) {
+  if (s.grasp == nullptr) return;
+  HandOffset& o = s.offsets.hands[size_t(h)];
+  const HandGrasp& g = s.grasp->grasp(h == 0 ? Hand::left : Hand::right);
+  const bool held = g.holding && g.solves > 0;
+  if (held) {
+    // Nothing shown yet: the new grasp's correction is taken whole, the blend brings it in.
+    if (o.blend <= 0.0f) o.current = g.result.handCorrection;
+    o.solved = g.result.handCorrection;
+    o.openClearance = std::isfinite(g.result.openClearance) ? g.result.openClearance : 0.0f;
+    o.displacement = g.result.handMoved;
+    o.exceeded = g.result.clearanceExceeded;
+  }
+  // Time, not frames: the blend takes as long at 60 Hz as at 120 Hz. A stalled app (a long gap)
+  // steps at most a quarter second.
+  const double dt =
+      o.last == 0 || s.predictedTime <= o.last ? 0.0 : double(s.predictedTime - o.last) * 1e-9;
+  o.last = s.predictedTime;
+  const float step =
+      s.offsets.blendTime > 0.0f ? float(std::min(dt, 0.25) / s.offsets.blendTime) : 1.0f;
+  o.blend = std::clamp(o.blend + (held ? step : -step), 0.0f, 1.0f);
+  const float follow = std::min(step, 1.0f);
+  o.current.position = glm::mix(o.current.position, o.solved.position, follow);
+  o.current.orientation =
+      glm::normalize(glm::slerp(o.current.orientation, o.solved.orientation, follow));
+}
+
+Pose shownHandOffset(const HandOffset& o) {
+  if (o.blend <= 0.0f) return Pose{};
+  // Smoothstep: the hand starts and ends its move at rest.
+  const float w = o.blend * o.blend * (3.0f - 2.0f * o.blend);
+  Pose p;
+  p.position = o.current.position * w;
+  p.orientation =
+      glm::normalize(glm::slerp(glm::quat(1.0f, 0.0f, 0.0f, 0.0f), o.current.orientation, w));
+  return p;
+}
+
+void applyHandOffset(const Pose& offset, JointPoses& joints) {
+  const Pose wrist = joints[size_t(Joint::wrist)];
+  const Pose move = wrist * offset * wrist.inverse();
+  for (Pose& j : joints) j = move * j;
+}
+
+void writeHandOffset(const SessionState& s, int h, void* next) {
+  auto* out = findInChain<XrGraspHandOffsetSDFG>(next, XR_TYPE_GRASP_HAND_OFFSET_SDFG);
+  if (out == nullptr) return;
+  const HandOffset& o = s.offsets.hands[size_t(h)];
+  const HandGrasp& g = s.grasp->grasp(h == 0 ? Hand::left : Hand::right);
+  const bool held = g.holding && g.solves > 0;
+  out->offset = toXr(shownHandOffset(o));
+  out->solvedOffset = toXr(held ? o.solved : Pose{});
+  out->blend = o.blend;
+  out->openClearance = held ? o.openClearance : 0.0f;
+  out->displacement = held ? o.displacement : 0.0f;
+  out->exceeded = held && o.exceeded ? XR_TRUE : XR_FALSE;
+}
+
+XrResult readClearanceOptions(const char* cmd, const void* next, ClearanceRequest& out) {
+  const auto* c =
+      findInChain<const XrGraspClearanceOptionsSDFG>(next, XR_TYPE_GRASP_CLEARANCE_OPTIONS_SDFG);
+  out = ClearanceRequest{};
+  if (c == nullptr) return XR_SUCCESS;
+  // Enums compared as integers: an app may pass any value.
+  auto isSwitch = [](XrGraspSwitchSDFG v) {
+    const int i = int(v);
+    return i >= int(XR_GRASP_SWITCH_DEFAULT_SDFG) && i <= int(XR_GRASP_SWITCH_ON_SDFG);
+  };
+  auto inRange = [](float v, float hi) { return v == 0.0f || (v > 0.0f && v <= hi); };
+  if (!isSwitch(c->clearance))
+    return logError(XR_ERROR_VALIDATION_FAILURE, cmd, "(clearanceOptions->clearance) is %d",
+                    int(c->clearance));
+  if (!isSwitch(c->approach))
+    return logError(XR_ERROR_VALIDATION_FAILURE, cmd, "(clearanceOptions->approach) is %d",
+                    int(c->approach));
+  if (!inRange(c->maxCorrection, 0.2f))
+    return logError(XR_ERROR_VALIDATION_FAILURE, cmd,
+                    "(clearanceOptions->maxCorrection) must be 0 or in (0, 0.2]");
+  if (!inRange(c->approachRange, 0.2f))
+    return logError(XR_ERROR_VALIDATION_FAILURE, cmd,
+                    "(clearanceOptions->approachRange) must be 0 or in (0, 0.2]");
+  if (!inRange(c->approachMaxAngle, 3.1416f))
+    return logError(XR_ERROR_VALIDATION_FAILURE, cmd,
+                    "(clearanceOptions->approachMaxAngle) must be 0 or in (0, pi]");
+  if (!inRange(c->blendTime, 2.0f))
+    return logError(XR_ERROR_VALIDATION_FAILURE, cmd,
+                    "(clearanceOptions->blendTime) must be 0 or in (0, 2]");
+  out.present = true;
+  out.options = *c;
+  return XR_SUCCESS;
+}
+
+}  // namespace sdfg::layer

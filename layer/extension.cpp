@@ -7,7 +7,6 @@
 
 #include "intercepts.h"
 #include "log.h"
-#include "mesh/mesh_orientation.h"
 #include "state.h"
 
 #if SDFG_LAYER_VULKAN
@@ -271,18 +270,11 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
                        std::span<const uint32_t>(arrays->indices, arrays->indexCount));
   SDFG_VERIFY(cmd, mesh.ok(), toXrResult(mesh.ok() ? Status::ok : mesh.error().code), "%s",
               mesh.ok() ? "" : mesh.error().message.c_str());
-  // Meshes come wound either way, or both: the core takes outward triangles (the SDF's sign).
-  const MeshOrientation orientation = orientOutward(mesh->positions, mesh->indices);
+  // Meshes come wound either way, or both: the session's worker turns every part outward while
+  // it sets the target up (its winding-number vote is too slow for this call), and updateGrasps
+  // logs once what it found.
   auto t = std::make_shared<TargetState>();
   t->handle = newLayerHandle();
-  if (orientation.flipped > 0)
-    SDFG_LOG_WARN(cmd, "target %#llx: mesh wound %s; %u of %zu triangles flipped to face outward",
-                  static_cast<unsigned long long>(t->handle), orientation.describe(),
-                  orientation.flipped, mesh->triangleCount());
-  else
-    SDFG_LOG_INFO(cmd, "target %#llx: mesh wound %s (%u parts, %u closed)",
-                  static_cast<unsigned long long>(t->handle), orientation.describe(),
-                  orientation.components, orientation.closedComponents);
   t->session = s;
   t->space = createInfo->placement.space;
   t->pose = createInfo->placement.pose;

@@ -146,7 +146,17 @@ void updateGrasps(SessionState& s) {
     noteGraspChange(s, hand, wasGrasping, wasTarget);
     advanceHandOffset(s, h);
   }
-  // Set-ups run on the session's worker: one line per target whose mesh it could not take.
+  // Set-ups run on the session's worker: one line per target on how its mesh was wound, and one
+  // per target whose mesh it could not take.
+  for (const auto& [id, o] : s.grasp->takeSetupOrientations()) {
+    if (o.flipped > 0)
+      SDFG_LOG_WARN(cmd, "target %#llx: mesh wound %s; %u triangles flipped to face outward",
+                    static_cast<unsigned long long>(id), o.describe(), o.flipped);
+    else
+      SDFG_LOG_INFO(cmd, "target %#llx: mesh wound %s (%u parts, %u closed)",
+                    static_cast<unsigned long long>(id), o.describe(), o.components,
+                    o.closedComponents);
+  }
   for (const auto& [id, why] : s.grasp->takeSetupFailures())
     SDFG_LOG_WARN(cmd, "grasp target 0x%llx cannot be grasped: its set-up failed (%s)",
                   static_cast<unsigned long long>(id), why.c_str());

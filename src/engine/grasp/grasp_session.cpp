@@ -85,8 +85,12 @@ Status GraspSession::addTarget(uint64_t id, TriangleMesh mesh) {
     targets_.emplace(id, std::move(t));
     return Status::ok;
   }
+  setupOrientations_.emplace_back(id, orientOutward(mesh.positions, mesh.indices));
   auto distance = MeshDistance::create(mesh);
-  if (!distance) return distance.error().code;
+  if (!distance) {
+    setupOrientations_.pop_back();
+    return distance.error().code;
+  }
   t.bounds = computeBounds(mesh.positions);
   t.distance = std::move(*distance);
   targets_.emplace(id, std::move(t));
@@ -106,6 +110,11 @@ std::vector<std::pair<uint64_t, std::string>> GraspSession::takeSetupFailures() 
   return std::exchange(setupFailures_, {});
 }
 
+std::vector<std::pair<uint64_t, MeshOrientation>> GraspSession::takeSetupOrientations() {
+  refreshSetups();
+  return std::exchange(setupOrientations_, {});
+}
+
 bool GraspSession::waitWorkerIdle(std::chrono::milliseconds timeout) const {
   return worker_ == nullptr || worker_->waitIdle(timeout);
 }
@@ -119,6 +128,10 @@ void GraspSession::refreshSetups() {
       // Bounds set by updateTargetVertices meanwhile are newer than the set-up's.
       if (t.version == 0) t.bounds = info.bounds;
       t.setup = TargetSetup::ready;
+      // The GPU's copy takes the triangles as the set-up turned them outward.
+      if (t.deviceCopy != nullptr && info.orientedIndices != nullptr)
+        t.deviceCopy->indices = *info.orientedIndices;
+      setupOrientations_.emplace_back(id, info.orientation);
     } else if (info.setup == TargetSetup::failed) {
       t.setup = TargetSetup::failed;
       setupFailures_.emplace_back(id, std::move(info.error));

@@ -136,6 +136,9 @@ class GraspSession {
   Status addTarget(uint64_t id, TriangleMesh mesh);
   // ready for targets set up in addTarget (caller threading) and device targets.
   TargetSetup targetSetup(uint64_t id) const;
+  // What each set-up finished since the last call found of its mesh's winding (addTarget turns
+  // every part outward, on the worker when there is one), for the owner to report once.
+  std::vector<std::pair<uint64_t, MeshOrientation>> takeSetupOrientations();
   // Targets whose set-up failed since the last call, with the reason (each reported once).
   std::vector<std::pair<uint64_t, std::string>> takeSetupFailures();
   // With a worker: waits until it has nothing queued or running, at most `timeout` (tests and
@@ -274,6 +277,7 @@ class GraspSession {
   SdfBuildStats stats_;
   GraspSettings settings_;
   std::map<uint64_t, Target> targets_;
+  std::vector<std::pair<uint64_t, MeshOrientation>> setupOrientations_;
   std::array<HandState, 2> hands_;
   std::vector<std::pair<uint64_t, std::string>> setupFailures_;
   std::unique_ptr<GraspWorker> worker_;  // last: joined before anything it could reach goes

@@ -87,7 +87,8 @@ GraspWorker::TargetInfo GraspWorker::targetInfo(uint64_t id) const {
   std::lock_guard lock(mutex_);
   auto it = targets_.find(id);
   if (it == targets_.end()) return {};
-  return {it->second->setup, it->second->bounds, it->second->error};
+  return {it->second->setup, it->second->bounds, it->second->error, it->second->orientation,
+          it->second->orientedIndices};
 }
 
 void GraspWorker::request(size_t slot, Job job) {
@@ -205,8 +206,16 @@ void GraspWorker::runSetup(std::unique_lock<std::mutex>& lock, uint64_t id,
   std::shared_ptr<MeshDistance> distance;
   std::string error;
   Aabb bounds;
+  MeshOrientation orientation;
+  std::shared_ptr<const std::vector<uint32_t>> orientedIndices;
   try {
     bounds = computeBounds(mesh.positions);
+    // Meshes come wound either way, or both: the SDF's sign needs outward triangles. An open
+    // part's winding-number vote costs O(samples x triangles), so it runs here, not in the app's
+    // create call.
+    orientation = orientOutward(mesh.positions, mesh.indices);
+    if (orientation.flipped > 0)
+      orientedIndices = std::make_shared<const std::vector<uint32_t>>(mesh.indices);
     auto made = MeshDistance::create(mesh);
     if (made)
       distance = std::move(*made);
@@ -226,6 +235,8 @@ void GraspWorker::runSetup(std::unique_lock<std::mutex>& lock, uint64_t id,
   if (distance != nullptr) {
     target->distance = std::move(distance);
     target->bounds = bounds;
+    target->orientation = orientation;
+    target->orientedIndices = std::move(orientedIndices);
     target->setup = TargetSetup::ready;
   } else {
     target->setup = TargetSetup::failed;

@@ -42,6 +42,7 @@
 #include "hand/hand_model.h"
 #include "mesh/mesh.h"
 #include "mesh/mesh_distance.h"
+#include "mesh/mesh_orientation.h"
 #include "sdf/sdf_backend.h"
 #include "sdf/sdf_grid.h"
 
@@ -62,6 +63,10 @@ class GraspWorker {
     TargetSetup setup = TargetSetup::unknown;
     Aabb bounds;        // of the positions last set up or refit (valid once ready)
     std::string error;  // why the set-up failed
+    // What the set-up found of the mesh's winding (orientOutward, valid once ready), and the
+    // indices it turned outward when it flipped any (null: the app's were outward already).
+    MeshOrientation orientation{};
+    std::shared_ptr<const std::vector<uint32_t>> orientedIndices;
   };
 
   // A solver and what to prepare it with. The worker prepares it before its first solve (the
@@ -157,6 +162,8 @@ class GraspWorker {
     TargetSetup setup = TargetSetup::pending;
     Aabb bounds;
     std::string error;
+    MeshOrientation orientation{};
+    std::shared_ptr<const std::vector<uint32_t>> orientedIndices;
   };
   struct Slot {
     std::optional<Job> queued;

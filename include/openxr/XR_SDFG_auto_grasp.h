@@ -81,10 +81,10 @@ typedef struct XrGraspTargetPlacementSDFG {
 // XR_ERROR_VALIDATION_FAILURE, on create and on update (new positions that collapse a triangle
 // are refused and the old ones stay).
 // Winding: any. The layer's convention is counter-clockwise (right-handed index order) seen from
-// outside, and at creation it detects each connected part's orientation (signed volume when the
-// part is closed, the generalized winding number when it is open, after making neighbouring
-// triangles consistent) and flips inside-out or mixed parts on its own copy; it logs what it
-// found once per target. A flat open sheet is taken as given. (Vulkan-buffer targets below are
+// outside, and while it sets the target up (off the app's thread) it detects each connected
+// part's orientation (signed volume when the part is closed, the generalized winding number when
+// it is open, after making neighbouring triangles consistent) and flips inside-out or mixed parts
+// on its own copy; it logs what it found once per target. A flat open sheet is taken as given. (Vulkan-buffer targets below are
 // not inspected: wind them counter-clockwise.)
 typedef struct XrGraspTargetVerticesSDFG {
   XrStructureType type;  // XR_TYPE_GRASP_TARGET_VERTICES_SDFG

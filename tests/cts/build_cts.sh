@@ -13,22 +13,9 @@ set -euo pipefail
 archive=$1
 out=$2
 jobs=${3:-2}
-if [ ! -f "$archive" ]; then
-  echo "SDFG_SKIPPED: no CTS archive at $archive"
-  exit 77
-fi
-hash=$(sha256sum "$archive" | cut -c1-16)
-root="$out/$hash"
-stamp="$root/built.stamp"
-if [ -f "$stamp" ]; then
-  echo "build_cts: cached build $root"
-  exit 0
-fi
-start=$(date +%s)
-rm -rf "$root"
-mkdir -p "$root"
-tar xJf "$archive" -C "$root"
-src=$(find "$root" -mindepth 1 -maxdepth 1 -type d | head -n1)
+name=cts
+# Sets root, stamp, src and start, or exits 77 (no archive) or 0 (already built).
+source "$(dirname "${BASH_SOURCE[0]}")/../third_party_unpack.sh"
 sed -i 's/FATAL_ERROR\(.*\)$/WARNING\1/' "$src/src/conformance/conformance_test/CMakeLists.txt"
 grep -q 'WARNING' "$src/src/conformance/conformance_test/CMakeLists.txt"
 cmake -S "$src" -B "$root/build" -G Ninja -DCMAKE_BUILD_TYPE=Release \

@@ -14,22 +14,9 @@ set -euo pipefail
 archive=$1
 out=$2
 jobs=${3:-2}
-if [ ! -f "$archive" ]; then
-  echo "SDFG_SKIPPED: no Monado archive at $archive"
-  exit 77
-fi
-hash=$(sha256sum "$archive" | cut -c1-16)
-root="$out/$hash"
-stamp="$root/built.stamp"
-if [ -f "$stamp" ]; then
-  echo "build_monado: cached build $root"
-  exit 0
-fi
-start=$(date +%s)
-rm -rf "$root"
-mkdir -p "$root"
-tar xJf "$archive" -C "$root"
-src=$(find "$root" -mindepth 1 -maxdepth 1 -type d | head -n1)
+name=monado
+# Sets root, stamp, src and start, or exits 77 (no archive) or 0 (already built).
+source "$(dirname "${BASH_SOURCE[0]}")/../third_party_unpack.sh"
 target_cmake="$src/src/xrt/targets/openxr/CMakeLists.txt"
 sed -i '/^\t\t\tcomp_main$/d' "$target_cmake"
 if grep -q 'comp_main' "$target_cmake"; then

@@ -37,7 +37,8 @@ const char* const kKeys[] = {"log_level",          "solver",
                              "extra_queue",        "test_gpu_fault",
                              "clear_hand",         "clear_bound",
                              "approach",           "approach_range",
-                             "approach_max_angle", "offset_blend_time"};
+                             "approach_max_angle", "offset_blend_time",
+                             "build_time_limit_ms"};
 
 }  // namespace
 
@@ -62,6 +63,10 @@ bool applyConfigValue(Config& config, const std::string& key, const std::string&
     ok = parseFloat(value, 1e-5f, 1.0f, c.curlStep);
   } else if (key == "sdf_far_band") {
     ok = parseFloat(value, 0.0f, 64.0f, c.sdfFarBand);
+  } else if (key == "build_time_limit_ms") {
+    float ms = 0;
+    ok = parseFloat(value, 1, 600000, ms) && ms == std::floor(ms);
+    c.buildTimeLimitMs = unsigned(ms);
   } else if (key == "exact_check") {
     ok = parseBool(value, c.exactCheck);
   } else if (key == "synthesis") {

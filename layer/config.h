@@ -18,6 +18,9 @@ struct Config {
   unsigned resolution = 16;            // resolution: grid nodes per axis, 2..128
   float curlStep = 0.02f;              // curl_step: solver step along each finger curve
   bool exactCheck = true;              // exact_check: "ours" checks stops on the exact mesh
+  // build_time_limit_ms: a CPU grab-box build running longer is given up (the hand stays open
+  // until released, with one log line); 1..600000.
+  unsigned buildTimeLimitMs = 1000;
   // sdf_far_band: CPU builds keep nodes within this many node spacings (of the configured box)
   // of the surface exact and may give farther ones a certified lower bound (CpuSdfOptions); 0:
   // every node exact.

@@ -141,8 +141,14 @@ void updateGrasps(SessionState& s) {
     const HandGrasp& before = s.grasp->grasp(hand);
     const bool wasGrasping = before.holding && before.solves > 0;
     const uint64_t wasTarget = before.target;
-    if (Status st = s.grasp->update(hand, frame, frames); st != Status::ok)
-      SDFG_LOG_WARN(cmd, "grasp solve failed (%s); the hand stays open", toString(st));
+    if (Status st = s.grasp->update(hand, frame, frames); st == Status::timed_out)
+      SDFG_LOG_WARN(cmd,
+                    "the grab's SDF build passed its time bound (build_time_limit_ms = %u); the "
+                    "hand stays open until it is released",
+                    inst.config.buildTimeLimitMs);
+    else if (st != Status::ok)
+      SDFG_LOG_WARN(cmd, "grasp solve failed (%s); the hand stays open until it is released",
+                    toString(st));
     noteGraspChange(s, hand, wasGrasping, wasTarget);
     advanceHandOffset(s, h);
   }
@@ -157,6 +163,11 @@ void updateGrasps(SessionState& s) {
                     static_cast<unsigned long long>(id), o.describe(), o.components,
                     o.closedComponents);
   }
+  for (const auto& [id, why] : s.grasp->takeRefusedUpdates())
+    SDFG_LOG_WARN(
+        "xrUpdateGraspTargetVerticesSDFG",
+        "grasp target 0x%llx: new vertices refused (%s); it keeps its last accepted shape",
+        static_cast<unsigned long long>(id), why.c_str());
   for (const auto& [id, why] : s.grasp->takeSetupFailures())
     SDFG_LOG_WARN(cmd, "grasp target 0x%llx cannot be grasped: its set-up failed (%s)",
                   static_cast<unsigned long long>(id), why.c_str());

@@ -42,6 +42,7 @@ XrResult toXrResult(Status status) {
       return XR_ERROR_OUT_OF_MEMORY;
     case Status::io_error:
     case Status::device_lost:
+    case Status::timed_out:
     case Status::internal:
       break;
   }
@@ -87,6 +88,7 @@ GraspSettings settingsFromConfig(const Config& config) {
   s.solver = resolveSolverName(config.solver);
   s.solverOptions.da = config.curlStep;
   s.exactCheck = config.exactCheck;
+  s.buildTimeLimit = std::chrono::milliseconds(config.buildTimeLimitMs);
   s.box.resolution = glm::uvec3(config.resolution);
   s.grabThreshold = config.grabThreshold;
   s.releaseRatio = config.releaseRatio;

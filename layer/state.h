@@ -171,8 +171,6 @@ struct TargetState {
   uint32_t vertexCount = 0;
   uint32_t indexCount = 0;
   bool deviceBuffers = false;  // the mesh is the app's Vulkan buffers
-  // Array targets: the triangles (as oriented outward), for checking vertex updates at once.
-  std::shared_ptr<const std::vector<uint32_t>> indices;
 };
 
 template <class T>

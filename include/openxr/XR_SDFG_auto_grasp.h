@@ -75,11 +75,17 @@ typedef struct XrGraspTargetPlacementSDFG {
 // Mesh as CPU arrays. The layer copies them; the app keeps ownership.
 // vertexCount: number of vertices (xyz float triples in `vertices`), 3..XR_MAX_..._VERTICES;
 // indexCount: number of uint32 indices, a multiple of 3, 3..XR_MAX_..._INDICES, each below
-// vertexCount. Every coordinate must be finite. Every triangle must have a non-zero area: one
-// that repeats an index, whose corners coincide (two indices naming vertices at the same
-// position) or whose corners are collinear is refused. Each of these is
-// XR_ERROR_VALIDATION_FAILURE, on create and on update (new positions that collapse a triangle
-// are refused and the old ones stay).
+// vertexCount. Every coordinate must be finite, and no triangle may repeat an index: each of
+// these is XR_ERROR_VALIDATION_FAILURE from the call, on create and on update. Every triangle
+// must also have a non-zero area (corners that coincide or are collinear). That rule is checked
+// off the app's thread, since it reads every triangle's corners (milliseconds per frame on a mesh
+// of a few hundred thousand triangles): a create call whose mesh breaks it succeeds, and the
+// target's set-up fails (never graspable; counted in XrGraspTargetsSetupInfoSDFG::failedCount;
+// one log line names the triangle); an update whose positions collapse a triangle succeeds, and
+// those positions are dropped when they would be applied (the target keeps its last accepted
+// shape; one log line per run of such updates).
+// Cost on the app's thread: create and update copy the arrays once, with the checks above fused
+// into the copy; everything else runs on the session's worker.
 // Winding: any. The layer's convention is counter-clockwise (right-handed index order) seen from
 // outside, and while it sets the target up (off the app's thread) it detects each connected
 // part's orientation (signed volume when the part is closed, the generalized winding number when
@@ -225,7 +231,9 @@ typedef struct XrGraspOptionsSDFG {
 // Registers a graspable mesh on `session`; writes `target` only on success.
 // Errors: HANDLE_INVALID (session; placement.space), VALIDATION_FAILURE (createInfo or target
 // null; a wrong `type` on createInfo, placement or the mesh struct; not exactly one mesh struct;
-// a chain too long; any rule of the mesh struct broken; a non-finite placement pose),
+// a chain too long; any rule of the mesh struct the call checks broken (see
+// XrGraspTargetVerticesSDFG for the zero-area rule, checked by the set-up); a non-finite
+// placement pose),
 // POSE_INVALID (placement orientation), GRAPHICS_DEVICE_INVALID and FEATURE_UNSUPPORTED (Vulkan
 // buffers, see XrGraspTargetVulkanBuffersSDFG), OUT_OF_MEMORY, SESSION_LOST, RUNTIME_FAILURE.
 typedef XrResult(XRAPI_PTR* PFN_xrCreateGraspTargetSDFG)(
@@ -240,8 +248,9 @@ typedef XrResult(XRAPI_PTR* PFN_xrDestroyGraspTargetSDFG)(XrGraspTargetSDFG targ
 // is solved again from the next xrSyncActions.
 // Errors: HANDLE_INVALID (target), VALIDATION_FAILURE (vertices null; its `type` neither mesh
 // struct; the wrong kind for the target; another vertex or index count; indexCount or indices
-// set on arrays; a non-finite coordinate; positions that give a triangle zero area; any rule of
-// XrGraspTargetVulkanBuffersSDFG broken; a chain too long), FEATURE_UNSUPPORTED (a buffer target
+// set on arrays; a non-finite coordinate; any rule of XrGraspTargetVulkanBuffersSDFG broken; a
+// chain too long; positions that give a triangle zero area are dropped later, see
+// XrGraspTargetVerticesSDFG), FEATURE_UNSUPPORTED (a buffer target
 // after the session's GPU path failed), SESSION_LOST, OUT_OF_MEMORY, RUNTIME_FAILURE.
 typedef XrResult(XRAPI_PTR* PFN_xrUpdateGraspTargetVerticesSDFG)(XrGraspTargetSDFG target,
                                                                  const void* vertices);

@@ -115,3 +115,48 @@ TEST_CASE("Destroying a target or the session while the worker sets it up is saf
   CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(30));
   CHECK(validationLog().empty());
 }
+
+TEST_CASE("New vertices that collapse a triangle of a held target leave its grasp as it was",
+          "[layer][worker]") {
+  const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+  applyEnv(squeezingRight(grip));
+  App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}});
+  REQUIRE(app.ok());
+  Ext ext(app);
+  const XrVector3f centre = boxCentreInLocal(grip, true);
+  const TestMesh sphere = makeIcosphere(0.04f, 3);
+  XrGraspTargetSDFG target = makeTarget(app, ext, sphere, {{0, 0, 0, 1}, centre});
+  REQUIRE(framesUntilGrasping(app, ext, XR_HAND_RIGHT_EXT));
+  auto state = [&] {
+    XrGraspBuildInfoSDFG build{XR_TYPE_GRASP_BUILD_INFO_SDFG};
+    XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG, &build};
+    XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
+    REQUIRE(ext.state(app.session, &gi, &st) == XR_SUCCESS);
+    return std::make_pair(st, build);
+  };
+  const auto [before, buildsBefore] = state();
+  // The sphere shrunk to 3/4, which the fingers would close further on, with its first
+  // triangle's corners at one point: the call takes it, the worker refuses it.
+  std::vector<XrVector3f> collapsed = sphere.vertices;
+  for (XrVector3f& p : collapsed) p = {p.x * 0.75f, p.y * 0.75f, p.z * 0.75f};
+  for (int k = 1; k < 3; ++k) collapsed[sphere.indices[size_t(k)]] = collapsed[sphere.indices[0]];
+  XrGraspTargetVerticesSDFG v{XR_TYPE_GRASP_TARGET_VERTICES_SDFG,
+                              nullptr,
+                              uint32_t(collapsed.size()),
+                              collapsed.data(),
+                              0,
+                              nullptr};
+  REQUIRE(ext.update(target, &v) == XR_SUCCESS);
+  // The outcome: the worker has re-solved the held hand (one more build), on the last shape.
+  REQUIRE(app.framesUntil([&] { return state().second.cpuBuildCount > buildsBefore.cpuBuildCount; },
+                          std::chrono::seconds(60)));
+  app.frames(2);
+  const auto [after, buildsAfter] = state();
+  REQUIRE(after.isGrasping);
+  for (int f = 0; f < XR_GRASP_FINGER_COUNT_SDFG; ++f) {
+    CAPTURE(f);
+    CHECK(after.fingers[f].curl == Approx(before.fingers[f].curl).margin(1e-5));
+    CHECK(after.fingers[f].inContact == before.fingers[f].inContact);
+  }
+  CHECK(validationLog().empty());
+}

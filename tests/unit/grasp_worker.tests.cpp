@@ -54,20 +54,28 @@ int contacts(const HandGrasp& g) {
   return n;
 }
 
-// A CPU backend that blocks its builds until released, to hold a job on the worker.
+// A CPU backend that blocks its builds until released, to hold a job on the worker. It honours
+// the build's WorkLimit as the CPU builder does, polling it while it waits.
 class GatedBackend final : public SdfBackend {
  public:
-  explicit GatedBackend(std::shared_ptr<std::atomic<bool>> open)
-      : open_(std::move(open)), cpu_(makeCpuSdfBackend(1)) {}
+  explicit GatedBackend(std::shared_ptr<std::atomic<bool>> open,
+                        std::shared_ptr<std::atomic<int>> calls = nullptr)
+      : open_(std::move(open)), calls_(std::move(calls)), cpu_(makeCpuSdfBackend(1)) {}
   std::string_view name() const override { return "gated"; }
-  Status build(const MeshDistance& target, const Pose& pose, const GridBox& box,
-               SdfGrid& out) override {
-    while (!open_->load()) std::this_thread::sleep_for(1ms);
-    return cpu_->build(target, pose, box, out);
+  using SdfBackend::build;
+  Status build(const MeshDistance& target, const Pose& pose, const GridBox& box, SdfGrid& out,
+               const WorkLimit& limit) override {
+    if (calls_ != nullptr) ++*calls_;
+    while (!open_->load()) {
+      if (limit.reached()) return Status::timed_out;
+      std::this_thread::sleep_for(1ms);
+    }
+    return cpu_->build(target, pose, box, out, limit);
   }
 
  private:
   std::shared_ptr<std::atomic<bool>> open_;
+  std::shared_ptr<std::atomic<int>> calls_;
   std::unique_ptr<SdfBackend> cpu_;
 };
 
@@ -234,14 +242,10 @@ TEST_CASE("Releasing, removing the target or destroying the session while a job 
     REQUIRE(session->update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
     CHECK_FALSE(session->grasp(Hand::right).holding);
   }
-  SECTION("destroying the session joins the worker after its job") {
+  SECTION("destroying the session stops the build in flight and joins the worker") {
     auto session = makeHeld();
-    std::thread opener([&] {
-      std::this_thread::sleep_for(20ms);
-      open->store(true);
-    });
+    // The gate never opens: without the stop flag this would wait for the build's time bound.
     session.reset();  // returns once the worker has ended; nothing runs after
-    opener.join();
     SUCCEED("destroyed");
   }
   SECTION("destroying the session with set-ups queued drops them") {
@@ -260,7 +264,9 @@ TEST_CASE("A failing job leaves the hand open and the worker working", "[grasp_w
   class FailingOnce final : public SdfBackend {
    public:
     std::string_view name() const override { return "failing-once"; }
-    Status build(const MeshDistance& t, const Pose& p, const GridBox& b, SdfGrid& out) override {
+    using SdfBackend::build;
+    Status build(const MeshDistance& t, const Pose& p, const GridBox& b, SdfGrid& out,
+                 const WorkLimit&) override {
       if (!failed_) {
         failed_ = true;
         throw std::bad_alloc();
@@ -358,4 +364,90 @@ TEST_CASE("A rigid motion of a held target re-solves on the field already built"
   REQUIRE(session.updateTargetVertices(7, smaller) == Status::ok);
   REQUIRE(updateUntil(session, squeezing(1.0f), target,
                       [&] { return session.buildStats().cpuBuilds > builds; }));
+}
+
+TEST_CASE("A build over its time bound is given up once per squeeze", "[grasp_worker][core]") {
+  // The gate never opens: every build runs into its bound (50 ms here, 1 s by default).
+  auto open = std::make_shared<std::atomic<bool>>(false);
+  auto calls = std::make_shared<std::atomic<int>>(0);
+  GraspSession session(std::make_unique<GatedBackend>(open, calls), nullptr,
+                       GraspThreading::worker);
+  GraspSettings settings = oursSettings();
+  settings.buildTimeLimit = 50ms;
+  REQUIRE(session.configure(settings) == Status::ok);
+  REQUIRE(session.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
+  REQUIRE(session.waitWorkerIdle(20s));
+  const TargetFrame target{7, true, Pose{}};
+  REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+  REQUIRE(session.grasp(Hand::right).holding);
+  REQUIRE(session.waitWorkerIdle(20s));
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  Status seen = Status::ok;
+  while (seen == Status::ok && std::chrono::steady_clock::now() < deadline)
+    seen = session.update(Hand::right, squeezing(1.0f), {&target, 1});
+  CHECK(seen == Status::timed_out);
+  CHECK_FALSE(session.grasp(Hand::right).holding);
+  // Still squeezing: no new grab, so no new build and no new failure to log.
+  CHECK(calls->load() == 1);
+  for (int i = 0; i < 20; ++i) {
+    CHECK(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    CHECK_FALSE(session.grasp(Hand::right).holding);
+  }
+  REQUIRE(session.waitWorkerIdle(20s));
+  CHECK(calls->load() == 1);
+  // Released and squeezed again, with the gate open: the grab succeeds.
+  REQUIRE(session.update(Hand::right, squeezing(0.0f), {&target, 1}) == Status::ok);
+  open->store(true);
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.grasp(Hand::right).solves > 0; }));
+}
+
+TEST_CASE("Settings refuse a build time bound that is not positive", "[grasp_worker][core]") {
+  GraspSettings settings = oursSettings();
+  settings.buildTimeLimit = 0ms;
+  CHECK(settings.validate().has_value());
+  GraspSession session(makeCpuSdfBackend(1), nullptr, GraspThreading::worker);
+  CHECK(session.configure(settings) == Status::invalid_argument);
+}
+
+TEST_CASE("New vertices that collapse a triangle are refused on the worker, once per run",
+          "[grasp_worker][core]") {
+  GraspSession session(makeCpuSdfBackend(1), nullptr, GraspThreading::worker);
+  REQUIRE(session.configure(oursSettings()) == Status::ok);
+  const TriangleMesh sphere = makeSphere(0.04f, 3);
+  REQUIRE(session.addTarget(7, sphere) == Status::ok);
+  REQUIRE(session.waitWorkerIdle(20s));
+  const TargetFrame target{7, true, Pose{}};
+  REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                      [&] { return session.grasp(Hand::right).solves > 0; }));
+  const float curl = session.grasp(Hand::right).result.fingers[2].curl;
+  // Triangle 0's corners all at one point; the sphere otherwise shrunk, which the hand would
+  // close further on if the update were taken.
+  std::vector<glm::vec3> collapsed = sphere.positions;
+  for (glm::vec3& p : collapsed) p *= 0.75f;
+  for (int k = 0; k < 3; ++k) collapsed[sphere.indices[size_t(k)]] = collapsed[sphere.indices[0]];
+  auto applyAndWait = [&](const std::vector<glm::vec3>& positions) {
+    const uint64_t solves = session.grasp(Hand::right).solves;
+    REQUIRE(session.updateTargetVertices(7, positions) == Status::ok);
+    REQUIRE(updateUntil(session, squeezing(1.0f), target,
+                        [&] { return session.grasp(Hand::right).solves > solves; }));
+  };
+  applyAndWait(collapsed);
+  // The hand still holds, on the last accepted shape.
+  CHECK(session.grasp(Hand::right).holding);
+  CHECK(session.grasp(Hand::right).result.fingers[2].curl == Approx(curl).margin(1e-4));
+  auto refused = session.takeRefusedUpdates();
+  REQUIRE(refused.size() == 1);
+  CHECK(refused[0].first == 7);
+  CHECK(refused[0].second.find("zero area") != std::string::npos);
+  applyAndWait(collapsed);  // the same run: not reported again
+  CHECK(session.takeRefusedUpdates().empty());
+  // Accepted positions end the run; the next refusal is reported again.
+  std::vector<glm::vec3> smaller = sphere.positions;
+  for (glm::vec3& p : smaller) p *= 0.75f;
+  applyAndWait(smaller);
+  CHECK(session.grasp(Hand::right).result.fingers[2].curl > curl + 0.01f);
+  CHECK(session.takeRefusedUpdates().empty());
+  applyAndWait(collapsed);
+  CHECK(session.takeRefusedUpdates().size() == 1);
 }

@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -359,6 +360,36 @@ TEST_CASE("The far-field band is validated", "[sdf_cpu][far]") {
     GridBox bad = box;
     bad.resolution = glm::uvec3(1);
     CHECK(builder.build(*d, kObjectFromHand, bad, grid, options) == Status::invalid_argument);
+  }
+}
+
+TEST_CASE("A build stops at its WorkLimit and leaves the grid as it was", "[sdf_cpu]") {
+  const auto d = makeDistance(icosphereMesh(0.05f, 3));
+  const GridBox box = boxAt(handPointFor(glm::vec3(0.03f, 0.0f, 0.02f)), 16);
+  const GridBox earlier = boxAt(handPointFor(glm::vec3(0.0f)), 8);
+  CpuSdfBuilder builder(2);
+  CpuSdfOptions exact, far;
+  far.exactBand = 0.02f;
+  for (const CpuSdfOptions& options : {exact, far}) {
+    SdfGrid grid;
+    REQUIRE(builder.build(*d, kObjectFromHand, earlier, grid, options) == Status::ok);
+    const std::vector<float> before(grid.values().begin(), grid.values().end());
+    // A deadline already passed, then the owner's stop flag.
+    const WorkLimit passed{WorkLimit::Clock::now() - std::chrono::milliseconds(1), nullptr};
+    CHECK(builder.build(*d, kObjectFromHand, box, grid, options, passed) == Status::timed_out);
+    const std::atomic<bool> stop{true};
+    CHECK(builder.build(*d, kObjectFromHand, box, grid, options,
+                        WorkLimit::after(std::chrono::hours(1), &stop)) == Status::timed_out);
+    CHECK(grid.box().resolution == earlier.resolution);
+    CHECK(std::equal(before.begin(), before.end(), grid.values().begin(), grid.values().end()));
+    // A limit that is not reached changes nothing in the result.
+    const std::atomic<bool> go{false};
+    SdfGrid limited, unlimited;
+    REQUIRE(builder.build(*d, kObjectFromHand, box, limited, options,
+                          WorkLimit::after(std::chrono::hours(1), &go)) == Status::ok);
+    REQUIRE(builder.build(*d, kObjectFromHand, box, unlimited, options) == Status::ok);
+    CHECK(std::equal(limited.values().begin(), limited.values().end(), unlimited.values().begin(),
+                     unlimited.values().end()));
   }
 }
 

@@ -16,6 +16,8 @@ const char* toString(Status status) {
       return "out of memory";
     case Status::device_lost:
       return "device lost";
+    case Status::timed_out:
+      return "timed out";
     case Status::internal:
       return "internal error";
   }

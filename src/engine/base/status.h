@@ -18,6 +18,7 @@ enum class Status {
   unsupported,       // valid request the current build or device cannot serve
   out_of_memory,
   device_lost,  // the GPU went away; callers fall back to the CPU path
+  timed_out,    // the work passed its time bound (WorkLimit) or its owner stopped it
   internal,     // a bug in this library
 };
 

@@ -33,6 +33,8 @@ std::optional<Error> GraspSettings::validate() const {
     return makeError(Status::invalid_argument, "grasp settings: releaseRatio must be in [0, 1]");
   if (!(moveTolerance >= 0.0f) || !(turnTolerance >= 0.0f))
     return makeError(Status::invalid_argument, "grasp settings: tolerances must be >= 0");
+  if (buildTimeLimit.count() <= 0)
+    return makeError(Status::invalid_argument, "grasp settings: buildTimeLimit must be positive");
   return std::nullopt;
 }
 
@@ -108,6 +110,11 @@ TargetSetup GraspSession::targetSetup(uint64_t id) const {
 std::vector<std::pair<uint64_t, std::string>> GraspSession::takeSetupFailures() {
   refreshSetups();
   return std::exchange(setupFailures_, {});
+}
+
+std::vector<std::pair<uint64_t, std::string>> GraspSession::takeRefusedUpdates() {
+  return worker_ != nullptr ? worker_->takeRefusedUpdates()
+                            : std::vector<std::pair<uint64_t, std::string>>{};
 }
 
 std::vector<std::pair<uint64_t, MeshOrientation>> GraspSession::takeSetupOrientations() {
@@ -256,6 +263,7 @@ bool GraspSession::removeTarget(uint64_t id) {
 void GraspSession::release(Hand hand) {
   cancelPending(hands_[size_t(hand)], size_t(hand));
   hands_[size_t(hand)].grasp = HandGrasp{};
+  hands_[size_t(hand)].waitForRelease = false;
 }
 
 Status GraspSession::setTargetHands(uint64_t id, bool left, bool right) {
@@ -329,6 +337,7 @@ void GraspSession::post(HandState& hand, size_t slot, uint64_t id, const Pose& o
   job.box = settings_.box;
   job.solver = hand.workerSolver;
   job.exactCheck = settings_.exactCheck;
+  job.buildTimeLimit = settings_.buildTimeLimit;
   job.field = std::move(field);
   worker_->request(slot, std::move(job));
   hand.jobPending = true;
@@ -347,6 +356,7 @@ Status GraspSession::collectJob(HandState& hand, size_t slot) {
   if (!hand.grasp.holding) return Status::ok;
   if (done->status != Status::ok) {
     hand.grasp = HandGrasp{};
+    hand.waitForRelease = true;
     return done->status;
   }
   hand.grasp.result = done->result;
@@ -487,6 +497,10 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   // A failed job left the hand open: it stays so for this frame (the caller logs why).
   if (collected != Status::ok) return collected;
   collected = collect(hand, slot);
+  if (hand.waitForRelease) {
+    if (hand.squeeze >= settings_.grabThreshold * settings_.releaseRatio) return collected;
+    hand.waitForRelease = false;
+  }
   if (hand.grasp.holding) {
     auto it = targets_.find(hand.grasp.target);
     if (it == targets_.end() || !it->second.hands[slot] ||
@@ -516,6 +530,7 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
     if (s != Status::ok) {
       cancelPending(hand, slot);
       hand.grasp = HandGrasp{};
+      hand.waitForRelease = true;
     }
     return s;
   }
@@ -546,6 +561,7 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   if (s != Status::ok) {
     cancelPending(hand, slot);
     hand.grasp = HandGrasp{};
+    hand.waitForRelease = true;
   }
   return s;
 }

@@ -63,6 +63,11 @@ struct GraspSettings {
   // the target's mesh (targets with a CPU mesh; device targets have none): 0.1 mm contacts
   // instead of the 16^3 field's millimetres, at tens to hundreds of microseconds per solve.
   bool exactCheck = true;
+  // The longest a grab-box SDF build on the worker may run before it is given up (the hand stays
+  // open, the caller logs why once, and the hand grabs again only after a release): a mesh the
+  // BVH serves badly (a soup of large intersecting triangles) must not keep a hand waiting for
+  // seconds. Positive.
+  std::chrono::milliseconds buildTimeLimit{1000};
 
   std::optional<Error> validate() const;
 };
@@ -141,6 +146,10 @@ class GraspSession {
   std::vector<std::pair<uint64_t, MeshOrientation>> takeSetupOrientations();
   // Targets whose set-up failed since the last call, with the reason (each reported once).
   std::vector<std::pair<uint64_t, std::string>> takeSetupFailures();
+  // With a worker: targets whose new vertices the worker refused since the last call (a triangle
+  // collapsed to zero area), with the reason. The target keeps its last accepted shape; a run of
+  // refused updates is reported once, at its first.
+  std::vector<std::pair<uint64_t, std::string>> takeRefusedUpdates();
   // With a worker: waits until it has nothing queued or running, at most `timeout` (tests and
   // tools only; false on timeout). True at once without one.
   bool waitWorkerIdle(std::chrono::milliseconds timeout) const;
@@ -241,6 +250,9 @@ class GraspSession {
     uint64_t pendingVersion = 0;
     int64_t pendingTime = 0;
     int64_t frameTime = 0;  // HandFrame::time of the update in progress
+    // A grab that failed (a build over its time bound, a refused solve) is not retried while
+    // the user keeps squeezing: once per squeeze, not once per frame.
+    bool waitForRelease = false;
     // A tracked hand's open-hand parts as the user holds it (wrist frame), cleared besides the
     // model's open hand (GraspScene::extraParts); 0 for a controller-driven hand.
     HandParts trackedParts{};

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 #include <new>
+#include <utility>
 
 #ifdef __linux__
 #include <pthread.h>
@@ -36,6 +37,7 @@ GraspWorker::~GraspWorker() {
   {
     std::lock_guard lock(mutex_);
     stop_ = true;
+    for (auto& flag : stopBuild_) flag.store(true, std::memory_order_relaxed);
   }
   wake_.notify_all();
   thread_.join();
@@ -80,7 +82,16 @@ void GraspWorker::removeTarget(uint64_t id) {
     if (it == targets_.end()) return;
     dropped = std::move(it->second);
     targets_.erase(it);
+    // A build for it is of no use to anyone now.
+    for (size_t slot = 0; slot < kSlots; ++slot)
+      if (slots_[slot].running && slots_[slot].runningTarget == id)
+        stopBuild_[slot].store(true, std::memory_order_relaxed);
   }
+}
+
+std::vector<std::pair<uint64_t, std::string>> GraspWorker::takeRefusedUpdates() {
+  std::lock_guard lock(mutex_);
+  return std::exchange(refusedUpdates_, {});
 }
 
 GraspWorker::TargetInfo GraspWorker::targetInfo(uint64_t id) const {
@@ -104,7 +115,10 @@ void GraspWorker::cancel(size_t slot) {
   Slot& s = slots_[slot];
   s.queued.reset();
   s.done.reset();
-  if (s.running) s.cancelledBelow = s.runningTicket + 1;
+  if (s.running) {
+    s.cancelledBelow = s.runningTicket + 1;
+    stopBuild_[slot].store(true, std::memory_order_relaxed);
+  }
 }
 
 std::optional<GraspWorker::Done> GraspWorker::take(size_t slot) {
@@ -209,18 +223,25 @@ void GraspWorker::runSetup(std::unique_lock<std::mutex>& lock, uint64_t id,
   MeshOrientation orientation;
   std::shared_ptr<const std::vector<uint32_t>> orientedIndices;
   try {
-    bounds = computeBounds(mesh.positions);
-    // Meshes come wound either way, or both: the SDF's sign needs outward triangles. An open
-    // part's winding-number vote costs O(samples x triangles), so it runs here, not in the app's
-    // create call.
-    orientation = orientOutward(mesh.positions, mesh.indices);
-    if (orientation.flipped > 0)
-      orientedIndices = std::make_shared<const std::vector<uint32_t>>(mesh.indices);
-    auto made = MeshDistance::create(mesh);
-    if (made)
-      distance = std::move(*made);
-    else
-      error = made.error().message;
+    // The app's thread checked counts, coordinates and indices in its one copying pass; the
+    // triangles' areas (a gather over the whole mesh, milliseconds for 400k triangles) are
+    // checked here, before the winding vote reads them.
+    if (auto refused = validateMesh(mesh.positions, mesh.indices)) {
+      error = refused->message;
+    } else {
+      bounds = computeBounds(mesh.positions);
+      // Meshes come wound either way, or both: the SDF's sign needs outward triangles. An open
+      // part's winding-number vote costs O(samples x triangles), so it runs here, not in the
+      // app's create call.
+      orientation = orientOutward(mesh.positions, mesh.indices);
+      if (orientation.flipped > 0)
+        orientedIndices = std::make_shared<const std::vector<uint32_t>>(mesh.indices);
+      auto made = MeshDistance::create(mesh);
+      if (made)
+        distance = std::move(*made);
+      else
+        error = made.error().message;
+    }
   } catch (const std::bad_alloc&) {
     error = "out of memory";
   } catch (...) {
@@ -248,6 +269,8 @@ void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job jo
   Slot& s = slots_[slot];
   s.running = true;
   s.runningTicket = job.ticket;
+  s.runningTarget = job.target;
+  stopBuild_[slot].store(false, std::memory_order_relaxed);
   std::shared_ptr<Target> target;
   std::optional<std::vector<glm::vec3>> positions;
   uint64_t version = 0;
@@ -278,12 +301,20 @@ void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job jo
   done.time = job.time;
   done.version = version;
   std::optional<Aabb> refitBounds;
+  std::optional<std::string> refused;  // why the positions were refused, at the first of a run
   try {
     MeshDistance* distance = target != nullptr ? target->distance.get() : nullptr;
     if (distance != nullptr && positions) {
-      // A deformed mesh: refit the hierarchy (O(n)), as the app's thread did before the worker.
-      done.status = distance->updatePositions(*positions);
-      if (done.status == Status::ok) refitBounds = computeBounds(*positions);
+      // A deformed mesh: refit the hierarchy (O(n)). Positions that collapse a triangle are
+      // refused by updatePositions, which leaves the last shape whole: the hand goes on with it.
+      if (distance->updatePositions(*positions) == Status::ok) {
+        refitBounds = computeBounds(*positions);
+        target->lastUpdateRefused = false;
+      } else if (!target->lastUpdateRefused) {
+        target->lastUpdateRefused = true;
+        auto why = findDegenerateTriangle(*positions, distance->mesh().indices);
+        refused = why ? why->message : std::string("the positions were refused");
+      }
     }
     const SdfGrid* field = job.field ? &*job.field : nullptr;
     BuiltField& built = fields_[slot];
@@ -302,8 +333,9 @@ void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job jo
                             built.version == version;
         built.valid = false;
         built.jobBox = job.box;
-        done.status = backend_->build(*distance, job.objectFromHand,
-                                      moving ? grownBox(job.box) : job.box, built.grid);
+        done.status =
+            backend_->build(*distance, job.objectFromHand, moving ? grownBox(job.box) : job.box,
+                            built.grid, WorkLimit::after(job.buildTimeLimit, &stopBuild_[slot]));
         done.built = done.status == Status::ok;
         if (done.built) {
           built.valid = true;
@@ -352,6 +384,7 @@ void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job jo
 
   lock.lock();
   ++jobsDone_;
+  if (refused) refusedUpdates_.emplace_back(s.runningTarget, std::move(*refused));
   if (target != nullptr && positions) {
     target->appliedVersion = version;
     if (refitBounds) target->bounds = *refitBounds;

@@ -13,15 +13,18 @@
 //   queue never grows); take() returns the newest finished result of a slot, if any, at once.
 // Set-ups run before hand jobs; the two slots take turns.
 //
-// Lifecycle: the destructor sets a stop flag, wakes the thread and joins it; the job running then
-// finishes first (a grab-box build: milliseconds; a set-up: up to its MeshDistance::create,
-// about a second for a million triangles), queued work is dropped. Removing a target while a job
+// Lifecycle: the destructor sets a stop flag, wakes the thread and joins it; a grab-box build
+// running then stops at its next row of nodes (WorkLimit), a set-up runs to its end (its
+// MeshDistance::create: about a second for a million triangles), queued work is dropped. A build
+// also stops when its slot is cancelled or its target removed, and when it passes the job's
+// buildTimeLimit (its result then says timed_out). Removing a target while a job
 // reads it is safe: the job holds its own reference. A job that throws (out of memory) or fails
 // reports its status in its result; the worker carries on.
 // Thread-safe: every public function may be called from any thread, while the worker runs.
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -93,6 +96,8 @@ class GraspWorker {
     GridBox box;
     std::shared_ptr<SolverSetup> solver;
     bool exactCheck = true;  // give the solver the target's exact distance
+    // The longest the CPU build may take; past it the job ends with timed_out.
+    std::chrono::milliseconds buildTimeLimit{1000};
     // A field built elsewhere (the GPU): solve on it, build nothing.
     std::optional<SdfGrid> field;
     int64_t time = 0;  // the frame time the hand and target poses belong to, echoed in Done
@@ -121,11 +126,17 @@ class GraspWorker {
   GraspWorker(const GraspWorker&) = delete;
   GraspWorker& operator=(const GraspWorker&) = delete;
 
-  // Queues the set-up of `mesh` (validated by makeMesh) under `id`; replaces a target of that id.
+  // Queues the set-up of `mesh` under `id`; replaces a target of that id. The set-up validates
+  // the mesh (validateMesh: the app's thread checks only what it can in one streaming pass), and
+  // fails with its message when it is refused.
   void addTarget(uint64_t id, TriangleMesh mesh);
   // New positions (same count as the mesh) of vertex version `version`; applied before the next
-  // build of the target. Unknown ids are ignored.
+  // build of the target. Unknown ids are ignored. Positions that collapse a triangle are refused
+  // when they are applied: the target keeps its last shape (takeRefusedUpdates says so).
   void updateVertices(uint64_t id, std::vector<glm::vec3> positions, uint64_t version);
+  // Targets whose positions were refused since the last call, with the reason; a run of refused
+  // updates of a target is reported once, at its first.
+  std::vector<std::pair<uint64_t, std::string>> takeRefusedUpdates();
   // A buffer for the next updateVertices() of `id`: one the worker is done with, of the mesh's
   // size when it has one (so filling it allocates nothing and touches no new pages), else empty.
   std::vector<glm::vec3> spareBuffer(uint64_t id);
@@ -164,11 +175,13 @@ class GraspWorker {
     std::string error;
     MeshOrientation orientation{};
     std::shared_ptr<const std::vector<uint32_t>> orientedIndices;
+    bool lastUpdateRefused = false;  // worker thread only: reports a run of refusals once
   };
   struct Slot {
     std::optional<Job> queued;
     bool running = false;
     uint64_t runningTicket = 0;
+    uint64_t runningTarget = 0;
     uint64_t cancelledBelow = 0;  // results of tickets below this are dropped
     std::optional<Done> done;
   };
@@ -197,6 +210,10 @@ class GraspWorker {
   std::unique_ptr<SdfBackend> backend_;  // worker thread only
   std::array<BuiltField, kSlots> fields_;
 
+  // Set to stop the build a slot's job runs (WorkLimit::stop): by cancel() and removeTarget() of
+  // the job's target, and by the destructor; cleared when the slot's next job starts.
+  std::array<std::atomic<bool>, kSlots> stopBuild_{};
+
   mutable std::mutex mutex_;  // guards everything below
   mutable std::condition_variable wake_;
   mutable std::condition_variable idle_;
@@ -208,6 +225,7 @@ class GraspWorker {
   bool busy_ = false;
   uint64_t setupsDone_ = 0;
   uint64_t jobsDone_ = 0;
+  std::vector<std::pair<uint64_t, std::string>> refusedUpdates_;
 
   std::thread thread_;  // last: started after every member above exists
 };

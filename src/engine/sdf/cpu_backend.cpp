@@ -13,9 +13,10 @@ class CpuBackend final : public SdfBackend {
   CpuBackend(unsigned threads, const CpuSdfOptions& options)
       : builder_(threads), options_(options) {}
   std::string_view name() const override { return "cpu"; }
+  using SdfBackend::build;
   Status build(const MeshDistance& target, const Pose& objectFromHand, const GridBox& box,
-               SdfGrid& out) override {
-    return builder_.build(target, objectFromHand, box, out, options_);
+               SdfGrid& out, const WorkLimit& limit) override {
+    return builder_.build(target, objectFromHand, box, out, options_, limit);
   }
 
  private:

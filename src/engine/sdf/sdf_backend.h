@@ -22,9 +22,14 @@ class SdfBackend {
   virtual std::string_view name() const = 0;
   // Fills `out` (resized to `box`) with the signed distance of `target` at every node;
   // `objectFromHand` places hand-space points in the mesh's space. A backend that fails with
-  // device_lost or unsupported lets the caller fall back to the CPU.
+  // device_lost or unsupported lets the caller fall back to the CPU. Once `limit` is reached
+  // the build stops with timed_out and leaves `out` as it was.
   virtual Status build(const MeshDistance& target, const Pose& objectFromHand, const GridBox& box,
-                       SdfGrid& out) = 0;
+                       SdfGrid& out, const WorkLimit& limit) = 0;
+  Status build(const MeshDistance& target, const Pose& objectFromHand, const GridBox& box,
+               SdfGrid& out) {
+    return build(target, objectFromHand, box, out, WorkLimit::none());
+  }
 };
 
 // The CPU builder (CpuSdfBuilder) behind the interface; threads == 0: one per hardware thread.

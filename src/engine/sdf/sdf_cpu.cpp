@@ -82,16 +82,22 @@ CpuSdfBuilder::CpuSdfBuilder(unsigned threads) {
 CpuSdfBuilder::~CpuSdfBuilder() = default;
 
 Status CpuSdfBuilder::build(const MeshDistance& target, const Pose& objectFromHand,
-                            const GridBox& box, SdfGrid& out, const CpuSdfOptions& options) {
+                            const GridBox& box, SdfGrid& out, const CpuSdfOptions& options,
+                            const WorkLimit& limit) {
   if (!(options.exactBand >= 0.0f) || !std::isfinite(options.exactBand)) {
     return Status::invalid_argument;
   }
-  if (options.exactBand == 0.0f) return build(target, objectFromHand, box, out);
-  return buildFar(target, objectFromHand, box, options.exactBand, out);
+  if (options.exactBand == 0.0f) return buildExact(target, objectFromHand, box, out, limit);
+  return buildFar(target, objectFromHand, box, options.exactBand, out, limit);
 }
 
 Status CpuSdfBuilder::build(const MeshDistance& target, const Pose& objectFromHand,
                             const GridBox& box, SdfGrid& out) {
+  return buildExact(target, objectFromHand, box, out, WorkLimit::none());
+}
+
+Status CpuSdfBuilder::buildExact(const MeshDistance& target, const Pose& objectFromHand,
+                                 const GridBox& box, SdfGrid& out, const WorkLimit& limit) {
   if (box.validate()) return Status::invalid_argument;
   SdfGrid grid(box);
   const Pose objectFromBox = objectFromHand * box.handFromBox;
@@ -105,6 +111,7 @@ Status CpuSdfBuilder::build(const MeshDistance& target, const Pose& objectFromHa
   const uint32_t rows = blocks.y * blocks.z;
   std::span<float> values = grid.values();
   std::atomic<uint32_t> nextRow{0};
+  std::atomic<bool> stopped{false};
 
   const std::function<void()> work = [&] {
     constexpr size_t kGroup = MeshDistance::kGroupSize;
@@ -112,6 +119,11 @@ Status CpuSdfBuilder::build(const MeshDistance& target, const Pose& objectFromHa
     for (;;) {
       const uint32_t row = nextRow.fetch_add(1, std::memory_order_relaxed);
       if (row >= rows) return;
+      // A row is at most kMaxGridResolution / 2 block queries: the bound is overrun by one row.
+      if (stopped.load(std::memory_order_relaxed) || limit.reached()) {
+        stopped.store(true, std::memory_order_relaxed);
+        return;
+      }
       const uint32_t j0 = 2 * (row % blocks.y), k0 = 2 * (row / blocks.y);
       // hint[c]: closest triangle last found at corner c = dx + 2 dy + 4 dz of a block.
       std::array<uint32_t, kGroup> hint;
@@ -144,6 +156,7 @@ Status CpuSdfBuilder::build(const MeshDistance& target, const Pose& objectFromHa
     }
   };
   pool_->run(work);
+  if (stopped.load()) return Status::timed_out;
   out = std::move(grid);
   lastExactNodes_ = box.nodeCount();
   return Status::ok;
@@ -208,7 +221,8 @@ uint32_t bracket(uint32_t i, uint32_t n, uint32_t s2, std::array<uint32_t, 2>& o
 }  // namespace
 
 Status CpuSdfBuilder::buildFar(const MeshDistance& target, const Pose& objectFromHand,
-                               const GridBox& box, float band, SdfGrid& out) {
+                               const GridBox& box, float band, SdfGrid& out,
+                               const WorkLimit& limit) {
   if (box.validate()) return Status::invalid_argument;
   SdfGrid grid(box);
   const Pose objectFromBox = objectFromHand * box.handFromBox;
@@ -307,11 +321,16 @@ Status CpuSdfBuilder::buildFar(const MeshDistance& target, const Pose& objectFro
     // triangle last found at the same block corner in the row, as build() does.
     const uint32_t rows = uint32_t(rowStart.size() - 1);
     std::atomic<uint32_t> nextRow{0};
+    std::atomic<bool> stopped{false};
     const std::function<void()> work = [&] {
       constexpr size_t kGroup = MeshDistance::kGroupSize;
       for (;;) {
         const uint32_t row = nextRow.fetch_add(1, std::memory_order_relaxed);
         if (row >= rows) return;
+        if (stopped.load(std::memory_order_relaxed) || limit.reached()) {
+          stopped.store(true, std::memory_order_relaxed);
+          return;
+        }
         std::array<uint32_t, 8> chain;
         chain.fill(kNoTriangle);
         std::array<glm::vec3, kGroup> pts;
@@ -345,15 +364,21 @@ Status CpuSdfBuilder::buildFar(const MeshDistance& target, const Pose& objectFro
       }
     };
     pool_->run(work);
+    if (stopped.load()) return Status::timed_out;
   }
 
   if (!needSign.empty()) {
     std::atomic<size_t> next{0};
+    std::atomic<bool> stopped{false};
     const std::function<void()> work = [&] {
       constexpr size_t kChunk = 16;
       for (;;) {
         const size_t first = next.fetch_add(kChunk, std::memory_order_relaxed);
         if (first >= needSign.size()) return;
+        if (stopped.load(std::memory_order_relaxed) || limit.reached()) {
+          stopped.store(true, std::memory_order_relaxed);
+          return;
+        }
         const size_t last = std::min(first + kChunk, needSign.size());
         for (size_t l = first; l < last; ++l) {
           sign[needSign[l]] = target.windingSign(points[needSign[l]]);
@@ -361,6 +386,7 @@ Status CpuSdfBuilder::buildFar(const MeshDistance& target, const Pose& objectFro
       }
     };
     pool_->run(work);
+    if (stopped.load()) return Status::timed_out;
   }
 
   // Max-plus closure over grid edges (see above). The edge length in object space is the box

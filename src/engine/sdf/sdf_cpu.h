@@ -15,6 +15,7 @@
 
 #include "base/pose.h"
 #include "base/status.h"
+#include "base/work_limit.h"
 #include "mesh/mesh_distance.h"
 #include "sdf/sdf_grid.h"
 
@@ -43,16 +44,20 @@ class CpuSdfBuilder {
   Status build(const MeshDistance& target, const Pose& objectFromHand, const GridBox& box,
                SdfGrid& out);
   // As above, with `options` (see CpuSdfOptions); the grid's exactBand() records the band.
+  // `limit` is polled before every row of nodes: once reached, the build stops with timed_out
+  // and `out` is left as it was.
   Status build(const MeshDistance& target, const Pose& objectFromHand, const GridBox& box,
-               SdfGrid& out, const CpuSdfOptions& options);
+               SdfGrid& out, const CpuSdfOptions& options, const WorkLimit& limit = {});
 
   // Nodes the last successful build queried exactly (all of them without a band).
   size_t lastExactNodes() const { return lastExactNodes_; }
 
  private:
   struct Pool;
+  Status buildExact(const MeshDistance& target, const Pose& objectFromHand, const GridBox& box,
+                    SdfGrid& out, const WorkLimit& limit);
   Status buildFar(const MeshDistance& target, const Pose& objectFromHand, const GridBox& box,
-                  float band, SdfGrid& out);
+                  float band, SdfGrid& out, const WorkLimit& limit);
   std::unique_ptr<Pool> pool_;
   size_t lastExactNodes_ = 0;
 };

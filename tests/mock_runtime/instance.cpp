@@ -148,10 +148,10 @@ XrResult setScriptText(Instance& instance, const char* text, const char* cmd) {
   }
   instance.script = std::move(parsed);
   applyOptions(instance);
-  if (!isKnownProfile(instance.options.profile)) {
-    std::fprintf(stderr, "[sdfg-mock-runtime] unknown profile %s\n",
+  if (!isSimulatedProfile(instance.options.profile)) {
+    std::fprintf(stderr, "[sdfg-mock-runtime] unknown or handless profile %s\n",
                  instance.options.profile.c_str());
-    return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "unknown profile %s",
+    return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "unknown or handless profile %s",
                 instance.options.profile.c_str());
   }
   return XR_SUCCESS;

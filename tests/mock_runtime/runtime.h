@@ -124,7 +124,7 @@ struct ActionSet final : Object {
 struct Binding {
   Action* action = nullptr;
   XrPath path = XR_NULL_PATH;
-  Target hand = kLeft;
+  Target hand = kLeft;     // kHead also for /user/gamepad: neither is ever read
   std::string identifier;  // "squeeze", "grip", "thumbstick", "haptic"
   std::string component;   // "value", "click", "pose", "x", "" for a parent path
 };
@@ -295,6 +295,8 @@ bool handTracked(const Session& session, Target hand);
 
 // Interaction profiles (interaction_profiles.cpp).
 bool isKnownProfile(const std::string& profilePath);
+// A profile with hand paths, which the simulated controllers can take.
+bool isSimulatedProfile(const std::string& profilePath);
 // Resolves a binding path for a profile; false when the profile has no such input or output.
 bool resolveBinding(const std::string& profilePath, const std::string& bindingPath, Binding& out);
 // Current value of a bound source from the script.

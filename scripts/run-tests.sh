@@ -14,7 +14,7 @@
 # incrementally; the tests that write into it clear their own folders first.
 #
 # SDFG_TEST_PRESETS (default: "default") lists the CMake presets to build and test, in order,
-# each with its own fresh shader cache; CI runs "asan tsan default" (see .ci/run). The run stops
+# each with its own fresh shader cache; CI runs "default asan tsan" (see .ci/run). The run stops
 # at the first preset with a failure, so ctest's summary line of the failing run is the last
 # thing printed.
 set -euo pipefail

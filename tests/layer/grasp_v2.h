@@ -25,8 +25,8 @@ bool runUntil(App& app, F done, std::chrono::milliseconds limit = std::chrono::s
   return app.framesUntil(done, limit);
 }
 
-// A controller-only runtime, one hand squeezing from frame `squeezeFrame` (and releasing at
-// `releaseFrame` when it is not 0), a tracker on it and one target.
+// A controller-only runtime, one hand squeezing from its sixth frame on (a test that releases
+// scripts it once the grasp is shown: App::setScript), a tracker on it and one target.
 struct GraspRun {
   std::unique_ptr<App> app;
   std::unique_ptr<Ext> ext;
@@ -35,12 +35,11 @@ struct GraspRun {
   XrGraspTargetSDFG target = XR_NULL_HANDLE;
 
   GraspRun(const TestMesh& mesh, const XrPosef& objectPose, const XrPosef& grip,
-           const char* handName = "right", uint64_t releaseFrame = 0) {
+           const char* handName = "right") {
     XrEnv env;
     env.handTracking = "absent";
     env.script = gripLine(0, handName, grip) + squeezeLine(0, handName, 0.0f) +
                  squeezeLine(4, handName, 0.0f) + squeezeLine(6, handName, 1.0f);
-    if (releaseFrame != 0) env.script += squeezeLine(releaseFrame, handName, 0.0f);
     applyEnv(env);
     app = std::make_unique<App>(
         AppOptions{{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}});

@@ -266,3 +266,58 @@ TEST_CASE("Actions are inactive when the app did not suggest bindings for the si
   CHECK(xr.stats(app.session).currentProfile == XR_NULL_PATH);
   CHECK(xr.validationMessages().empty());
 }
+
+TEST_CASE("Every core OpenXR 1.0 profile takes its own bindings and refuses others'",
+          "[runtime][actions]") {
+  XrHarness xr;
+  REQUIRE(xr.createResult() == XR_SUCCESS);
+  XrActionSetCreateInfo setInfo{XR_TYPE_ACTION_SET_CREATE_INFO};
+  std::snprintf(setInfo.actionSetName, sizeof setInfo.actionSetName, "profiles");
+  std::snprintf(setInfo.localizedActionSetName, sizeof setInfo.localizedActionSetName, "Profiles");
+  XrActionSet set = XR_NULL_HANDLE;
+  REQUIRE(xrCreateActionSet(xr.instance(), &setInfo, &set) == XR_SUCCESS);
+  XrActionCreateInfo info{XR_TYPE_ACTION_CREATE_INFO};
+  std::snprintf(info.actionName, sizeof info.actionName, "press");
+  std::snprintf(info.localizedActionName, sizeof info.localizedActionName, "Press");
+  info.actionType = XR_ACTION_TYPE_BOOLEAN_INPUT;
+  XrAction press = XR_NULL_HANDLE;
+  REQUIRE(xrCreateAction(set, &info, &press) == XR_SUCCESS);
+  auto suggest = [&](const char* profile, const char* binding) {
+    const XrActionSuggestedBinding b{press, xr.path(binding)};
+    XrInteractionProfileSuggestedBinding s{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+    s.interactionProfile = xr.path(profile);
+    s.countSuggestedBindings = 1;
+    s.suggestedBindings = &b;
+    return xrSuggestInteractionProfileBindings(xr.instance(), &s);
+  };
+  // The four the mock cannot simulate as controllers, with their own top-level paths.
+  CHECK(suggest("/interaction_profiles/htc/vive_pro", "/user/head/input/system/click") ==
+        XR_SUCCESS);
+  CHECK(suggest("/interaction_profiles/microsoft/xbox_controller", "/user/gamepad/input/a/click") ==
+        XR_SUCCESS);
+  CHECK(suggest("/interaction_profiles/google/daydream_controller",
+                "/user/hand/right/input/trackpad/click") == XR_SUCCESS);
+  CHECK(suggest("/interaction_profiles/oculus/go_controller", "/user/hand/left/input/back/click") ==
+        XR_SUCCESS);
+  // Paths of another profile, or of no profile.
+  CHECK(suggest("/interaction_profiles/microsoft/xbox_controller",
+                "/user/hand/left/input/a/click") == XR_ERROR_PATH_UNSUPPORTED);
+  CHECK(suggest("/interaction_profiles/htc/vive_pro", "/user/gamepad/input/a/click") ==
+        XR_ERROR_PATH_UNSUPPORTED);
+  CHECK(suggest("/interaction_profiles/oculus/go_controller",
+                "/user/hand/left/input/squeeze/click") == XR_ERROR_PATH_UNSUPPORTED);
+  CHECK(xr.validationMessages().empty());
+}
+
+TEST_CASE("A profile without hands cannot be the simulated controllers'", "[runtime][actions]") {
+  for (const char* profile :
+       {"/interaction_profiles/htc/vive_pro", "/interaction_profiles/microsoft/xbox_controller",
+        "/interaction_profiles/nowhere/none"}) {
+    CAPTURE(profile);
+    sdfg::test::InstanceOptions options;
+    options.env = {{SDFG_MOCK_ENV_PROFILE, profile}};
+    XrHarness xr(options);
+    // The mock refuses with XR_ERROR_VALIDATION_FAILURE; the loader reports the failed chain.
+    CHECK(XR_FAILED(xr.createResult()));
+  }
+}

@@ -3,6 +3,8 @@
 // by a later update(); a device failure redoes the build on the CPU in the same update.
 #include <catch2/catch.hpp>
 
+#include <chrono>
+
 #include "grasp/grasp_session.h"
 #include "io/shapes.h"
 #include "sdf/sdf_cpu.h"
@@ -168,6 +170,30 @@ TEST_CASE("GraspSession with a deferred backend solves only after the owner subm
     REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
     CHECK(session.grasp(Hand::right).solves == 0);
     CHECK(session.buildStats().gpuBuilds == 0);
+  }
+  SECTION("a device build not done within the time bound is given up until a release") {
+    GraspSettings settings;
+    settings.buildTimeLimit = std::chrono::milliseconds(30);
+    REQUIRE(session.configure(settings) == Status::ok);  // drops the build in flight
+    REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    REQUIRE(session.submitDeferred(true) == Status::ok);
+    gpu.busy = true;  // the device never finishes
+    const int cancels = gpu.cancels;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    Status seen = Status::ok;
+    while (seen == Status::ok && std::chrono::steady_clock::now() < deadline)
+      seen = session.update(Hand::right, squeezing(1.0f), {&target, 1});
+    CHECK(seen == Status::timed_out);
+    CHECK_FALSE(session.grasp(Hand::right).holding);
+    CHECK(gpu.cancels == cancels + 1);
+    // Still squeezing: no new request; after a release, a new grab asks again.
+    const int requests = gpu.requests;
+    REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    CHECK(gpu.requests == requests);
+    gpu.busy = false;
+    REQUIRE(session.update(Hand::right, squeezing(0.0f), {&target, 1}) == Status::ok);
+    REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    CHECK(session.grasp(Hand::right).holding);
   }
   SECTION("a device target needs a backend that holds its mesh") {
     CHECK(session.addDeviceTarget(9, Aabb{glm::vec3(-0.1f), glm::vec3(0.1f)}) ==

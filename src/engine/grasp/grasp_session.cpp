@@ -386,6 +386,7 @@ Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Targ
         deferred_->request(slot, id, target.version, mesh, objectFromHand, settings_.box);
     if (s == Status::ok) {
       hand.pending = true;
+      hand.pendingSince = std::chrono::steady_clock::now();
       hand.pendingPose = objectFromHand;
       hand.pendingVersion = target.version;
       hand.pendingTime = hand.frameTime;
@@ -500,6 +501,13 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   if (hand.waitForRelease) {
     if (hand.squeeze >= settings_.grabThreshold * settings_.releaseRatio) return collected;
     hand.waitForRelease = false;
+  }
+  if (hand.pending &&
+      std::chrono::steady_clock::now() - hand.pendingSince > settings_.buildTimeLimit) {
+    cancelPending(hand, slot);
+    hand.grasp = HandGrasp{};
+    hand.waitForRelease = true;
+    return Status::timed_out;
   }
   if (hand.grasp.holding) {
     auto it = targets_.find(hand.grasp.target);

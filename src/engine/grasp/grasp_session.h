@@ -63,10 +63,11 @@ struct GraspSettings {
   // the target's mesh (targets with a CPU mesh; device targets have none): 0.1 mm contacts
   // instead of the 16^3 field's millimetres, at tens to hundreds of microseconds per solve.
   bool exactCheck = true;
-  // The longest a grab-box SDF build on the worker may run before it is given up (the hand stays
-  // open, the caller logs why once, and the hand grabs again only after a release): a mesh the
-  // BVH serves badly (a soup of large intersecting triangles) must not keep a hand waiting for
-  // seconds. Positive.
+  // The longest a grab-box SDF build may run before it is given up (the hand stays open, the
+  // caller logs why once, and the hand grabs again only after a release): a mesh the BVH serves
+  // badly (a soup of large intersecting triangles) must not keep a hand waiting for seconds, nor
+  // a device build that never completes. CPU builds on the worker stop at it; a deferred (GPU)
+  // build still not collected after it is cancelled. Positive.
   std::chrono::milliseconds buildTimeLimit{1000};
 
   std::optional<Error> validate() const;
@@ -249,6 +250,9 @@ class GraspSession {
     Pose pendingPose;
     uint64_t pendingVersion = 0;
     int64_t pendingTime = 0;
+    // When the deferred build was requested: one still not collected after buildTimeLimit is
+    // given up, as a CPU build past it is (a device that never finishes must not hold a hand).
+    std::chrono::steady_clock::time_point pendingSince{};
     int64_t frameTime = 0;  // HandFrame::time of the update in progress
     // A grab that failed (a build over its time bound, a refused solve) is not retried while
     // the user keeps squeezing: once per squeeze, not once per frame.

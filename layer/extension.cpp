@@ -129,13 +129,12 @@ XrResult copyArrays(const char* cmd, const XrGraspTargetVerticesSDFG* v, Triangl
                   XR_ERROR_VALIDATION_FAILURE, "(vertices[%u]) is not finite", i);
     }
   }
-  out.indices.resize(v->indexCount);
+  // Copied first (one write of fresh memory, not a zero-fill and a write), then checked.
+  out.indices.assign(v->indices, v->indices + v->indexCount);
   uint32_t largest = 0, repeats = 0;
+  const uint32_t* idx = out.indices.data();
   for (uint32_t t = 0; t < v->indexCount; t += 3) {
-    const uint32_t a = v->indices[t], b = v->indices[t + 1], c = v->indices[t + 2];
-    out.indices[t] = a;
-    out.indices[t + 1] = b;
-    out.indices[t + 2] = c;
+    const uint32_t a = idx[t], b = idx[t + 1], c = idx[t + 2];
     largest = std::max(largest, std::max(a, std::max(b, c)));
     repeats |= uint32_t(a == b) | uint32_t(b == c) | uint32_t(a == c);
   }

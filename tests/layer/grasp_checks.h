@@ -78,6 +78,28 @@ inline bool framesUntilGrasping(App& app, const Ext& ext, XrHandEXT hand, bool g
   }
 }
 
+// The session's target set-up counts (XrGraspTargetsSetupInfoSDFG, chained on a state query).
+inline XrGraspTargetsSetupInfoSDFG setupInfo(const App& app, const Ext& ext) {
+  XrGraspTargetsSetupInfoSDFG setup{XR_TYPE_GRASP_TARGETS_SETUP_INFO_SDFG};
+  XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG, &setup};
+  XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
+  REQUIRE(ext.state(app.session, &gi, &st) == XR_SUCCESS);
+  return setup;
+}
+
+// Waits, without running frames (so a scripted squeeze waits too), until `done(setupInfo)` holds:
+// set-ups run on the session's worker, as long as the machine needs. False after `timeout`.
+template <class F>
+bool untilSetUp(const App& app, const Ext& ext, F done,
+                std::chrono::milliseconds timeout = std::chrono::seconds(60)) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!done(setupInfo(app, ext))) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return true;
+}
+
 inline float length(const XrVector3f& v) {
   return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
 }

@@ -2,9 +2,6 @@
 // run time, and which of several targets in the grab box a grab takes.
 #include <catch2/catch.hpp>
 
-#include <chrono>
-#include <thread>
-
 #include "grasp_v2.h"
 
 namespace {
@@ -42,20 +39,6 @@ XrGraspTargetSDFG makeTargetFor(const GraspRun& run, const TestMesh& mesh, const
   XrGraspTargetSDFG t = XR_NULL_HANDLE;
   REQUIRE(run.ext->create(run.app->session, &ci, &t) == XR_SUCCESS);
   return t;
-}
-
-// Waits (without running frames, so the scripted squeeze waits too) until `count` targets are
-// set up on the session's worker: a grab picks among the targets ready at that frame, and a
-// slow machine (or a sanitizer) may still be setting one up.
-bool waitSetUp(const GraspRun& run, uint32_t count) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  for (;;) {
-    XrGraspTargetsSetupInfoSDFG setup{XR_TYPE_GRASP_TARGETS_SETUP_INFO_SDFG};
-    XrGraspStateSDFG s{XR_TYPE_GRASP_STATE_SDFG, &setup};
-    if (run.state(s) == XR_SUCCESS && setup.readyCount >= count) return true;
-    if (std::chrono::steady_clock::now() > deadline) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
 }
 
 }  // namespace
@@ -106,7 +89,8 @@ TEST_CASE("Of several targets in the grab box, the grab takes the nearest the bo
   const XrGraspTargetSDFG nearer =
       makeTargetFor(run, small, {{0, 0, 0, 1}, offset(centre, 0.01f)},
                     nearerAllowed ? XR_GRASP_HAND_RIGHT_BIT_SDFG : XR_GRASP_HAND_LEFT_BIT_SDFG);
-  REQUIRE(waitSetUp(run, 2));
+  // A grab picks among the targets ready at its frame: both must be set up before the squeeze.
+  REQUIRE(untilSetUp(*run.app, *run.ext, [](const auto& setup) { return setup.readyCount >= 2; }));
   REQUIRE(runUntil(*run.app, [&] { return run.grasping(); }));
   // The nearest the hand may grasp.
   CHECK(heldTarget(run) == (nearerAllowed ? nearer : farther));

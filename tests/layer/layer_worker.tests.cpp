@@ -16,14 +16,6 @@ namespace {
 
 using namespace sdfg::test;
 
-XrGraspTargetsSetupInfoSDFG setupInfo(const App& app, const Ext& ext) {
-  XrGraspTargetsSetupInfoSDFG setup{XR_TYPE_GRASP_TARGETS_SETUP_INFO_SDFG};
-  XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG, &setup};
-  XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
-  REQUIRE(ext.state(app.session, &gi, &st) == XR_SUCCESS);
-  return setup;
-}
-
 XrEnv squeezingRight(const XrPosef& grip) {
   XrEnv env;
   env.handTracking = "absent";
@@ -48,9 +40,7 @@ TEST_CASE("A target is set up off the app's thread and graspable once the set-up
   setup = setupInfo(app, ext);
   CHECK(setup.readyCount + setup.pendingCount == 1);  // ready, or still being set up
   CHECK(setup.failedCount == 0);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (setupInfo(app, ext).readyCount != 1 && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  CHECK(untilSetUp(app, ext, [](const auto& setup) { return setup.readyCount == 1; }));
   CHECK(setupInfo(app, ext).readyCount == 1);
   REQUIRE(framesUntilGrasping(app, ext, XR_HAND_RIGHT_EXT));
   REQUIRE(ext.destroy(target) == XR_SUCCESS);

@@ -103,6 +103,20 @@ bool copyFinite(const XrVector3f* in, uint32_t n, glm::vec3* out, Aabb& bounds) 
   return sum == 0.0f;
 }
 
+// copyFinite with the documented error: names the first non-finite vertex, looked for only
+// when the copy found one.
+XrResult copyFiniteVertices(const char* cmd, const XrGraspTargetVerticesSDFG* v, glm::vec3* out,
+                            Aabb& bounds) {
+  if (copyFinite(v->vertices, v->vertexCount, out, bounds)) return XR_SUCCESS;
+  for (uint32_t i = 0; i < v->vertexCount; ++i) {
+    const XrVector3f& p = v->vertices[i];
+    SDFG_VERIFY(cmd, std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z),
+                XR_ERROR_VALIDATION_FAILURE, "(vertices[%u]) is not finite", i);
+  }
+  // Not reached (copyFinite saw a non-finite coordinate), but never taken for a success.
+  return logError(XR_ERROR_VALIDATION_FAILURE, cmd, "(vertices) has a non-finite coordinate");
+}
+
 // The create call's checks of the CPU arrays fused with their copy into `out`, one streaming
 // pass over each array: counts, pointers, finite coordinates, index range, no triangle that
 // repeats a vertex. What needs a gather over the whole mesh (zero-area triangles) is the set-up's
@@ -121,14 +135,8 @@ XrResult copyArrays(const char* cmd, const XrGraspTargetVerticesSDFG* v, Triangl
   SDFG_VERIFY_NOT_NULL(cmd, v->indices);
   out.positions.resize(v->vertexCount);
   Aabb bounds;
-  if (!copyFinite(v->vertices, v->vertexCount, out.positions.data(), bounds)) {
-    // Only now is the culprit looked for.
-    for (uint32_t i = 0; i < v->vertexCount; ++i) {
-      const XrVector3f& p = v->vertices[i];
-      SDFG_VERIFY(cmd, std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z),
-                  XR_ERROR_VALIDATION_FAILURE, "(vertices[%u]) is not finite", i);
-    }
-  }
+  if (XrResult r = copyFiniteVertices(cmd, v, out.positions.data(), bounds); r != XR_SUCCESS)
+    return r;
   // Copied first (one write of fresh memory, not a zero-fill and a write), then checked.
   out.indices.assign(v->indices, v->indices + v->indexCount);
   uint32_t largest = 0, repeats = 0;
@@ -165,15 +173,7 @@ XrResult copyVertices(const char* cmd, const XrGraspTargetVerticesSDFG* v,
   SDFG_VERIFY(cmd, v->indexCount == 0 && v->indices == nullptr, XR_ERROR_VALIDATION_FAILURE,
               "(indexCount) and (indices) must be 0 and NULL on update: the topology is fixed");
   out.resize(v->vertexCount);
-  if (!copyFinite(v->vertices, v->vertexCount, out.data(), bounds)) {
-    // Only now is the culprit looked for.
-    for (uint32_t i = 0; i < v->vertexCount; ++i) {
-      const XrVector3f& p = v->vertices[i];
-      SDFG_VERIFY(cmd, std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z),
-                  XR_ERROR_VALIDATION_FAILURE, "(vertices[%u]) is not finite", i);
-    }
-  }
-  return XR_SUCCESS;
+  return copyFiniteVertices(cmd, v, out.data(), bounds);
 }
 
 // Checks a Vulkan-buffer description; `target` (update) fixes the counts.

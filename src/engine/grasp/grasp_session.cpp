@@ -260,6 +260,12 @@ bool GraspSession::removeTarget(uint64_t id) {
   return targets_.erase(id) != 0;
 }
 
+void GraspSession::giveUp(HandState& hand, size_t slot) {
+  cancelPending(hand, slot);
+  hand.grasp = HandGrasp{};
+  hand.waitForRelease = true;
+}
+
 void GraspSession::release(Hand hand) {
   cancelPending(hands_[size_t(hand)], size_t(hand));
   hands_[size_t(hand)].grasp = HandGrasp{};
@@ -355,8 +361,7 @@ Status GraspSession::collectJob(HandState& hand, size_t slot) {
   if (hand.jobOnGpu) ++stats_.gpuBuilds;
   if (!hand.grasp.holding) return Status::ok;
   if (done->status != Status::ok) {
-    hand.grasp = HandGrasp{};
-    hand.waitForRelease = true;
+    giveUp(hand, slot);
     return done->status;
   }
   hand.grasp.result = done->result;
@@ -504,9 +509,7 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   }
   if (hand.pending &&
       std::chrono::steady_clock::now() - hand.pendingSince > settings_.buildTimeLimit) {
-    cancelPending(hand, slot);
-    hand.grasp = HandGrasp{};
-    hand.waitForRelease = true;
+    giveUp(hand, slot);
     return Status::timed_out;
   }
   if (hand.grasp.holding) {
@@ -535,11 +538,7 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
       return collected;
     noteTrackedParts(hand, frame);
     const Status s = solve(hand, slot, it->first, it->second, objectFromHand);
-    if (s != Status::ok) {
-      cancelPending(hand, slot);
-      hand.grasp = HandGrasp{};
-      hand.waitForRelease = true;
-    }
+    if (s != Status::ok) giveUp(hand, slot);
     return s;
   }
 
@@ -566,11 +565,7 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   const Pose objectFromHand = located->worldFromObject.inverse() * frame.worldFromWrist;
   hand.objectFromHandNow = objectFromHand;
   const Status s = solve(hand, slot, *id, target, objectFromHand);
-  if (s != Status::ok) {
-    cancelPending(hand, slot);
-    hand.grasp = HandGrasp{};
-    hand.waitForRelease = true;
-  }
+  if (s != Status::ok) giveUp(hand, slot);
   return s;
 }
 

@@ -275,6 +275,9 @@ class GraspSession {
   Status collect(HandState& hand, size_t slot);
   // Takes the worker's finished job for the hand, if any.
   Status collectJob(HandState& hand, size_t slot);
+  // A grab that failed: drops what is in flight, opens the hand, and starts no new grab until the
+  // squeeze is released (HandState::waitForRelease).
+  void giveUp(HandState& hand, size_t slot);
   // Hands a build (none when `field` is set) and solve to the worker.
   void post(HandState& hand, size_t slot, uint64_t id, const Pose& objectFromHand,
             std::optional<SdfGrid> field, bool gpu, int64_t time);

@@ -212,6 +212,11 @@ void GraspWorker::run() {
   idle_.notify_all();
 }
 
+void GraspWorker::keepSpares(Target& target, std::vector<std::vector<glm::vec3>>& buffers) {
+  for (auto& b : buffers)
+    if (target.spares.size() < kMaxSpares) target.spares.push_back(std::move(b));
+}
+
 void GraspWorker::runSetup(std::unique_lock<std::mutex>& lock, uint64_t id,
                            std::shared_ptr<Target> target) {
   TriangleMesh mesh = std::move(*target->setupMesh);
@@ -270,8 +275,7 @@ void GraspWorker::runSetup(std::unique_lock<std::mutex>& lock, uint64_t id,
     target->bounds = bounds;
     target->orientation = orientation;
     target->orientedIndices = std::move(orientedIndices);
-    for (auto& b : spares)
-      if (target->spares.size() < 3) target->spares.push_back(std::move(b));
+    keepSpares(*target, spares);
     target->setup = TargetSetup::ready;
   } else {
     target->setup = TargetSetup::failed;
@@ -297,7 +301,7 @@ void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job jo
   }
   // A deforming target: fill its pool of buffers here, off the app's thread.
   const size_t missingSpares =
-      positions && target->spares.size() < 2 ? 2 - target->spares.size() : 0;
+      positions && target->spares.size() < kMinSpares ? kMinSpares - target->spares.size() : 0;
   lock.unlock();
   std::vector<std::vector<glm::vec3>> newSpares;
   if (missingSpares > 0) {
@@ -310,8 +314,7 @@ void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job jo
     // two, and the app's next updates must find a buffer meanwhile (else one allocates and
     // faults in its pages on the app's thread: 5.7 ms once for 200k vertices).
     lock.lock();
-    for (auto& b : newSpares)
-      if (target->spares.size() < 3) target->spares.push_back(std::move(b));
+    keepSpares(*target, newSpares);
     lock.unlock();
   }
 

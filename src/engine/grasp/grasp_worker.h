@@ -167,7 +167,7 @@ class GraspWorker {
     // Used positions buffers, handed out again (spareBuffer). Three circulate for a mesh that
     // deforms every frame (the app fills one, one waits, the worker applies one), so after the
     // first updates nothing is allocated on the app's thread.
-    std::vector<std::vector<glm::vec3>> spares;
+    std::vector<std::vector<glm::vec3>> spares;  // kMinSpares..kMaxSpares once in use
     uint64_t positionsVersion = 0;
     uint64_t appliedVersion = 0;
     TargetSetup setup = TargetSetup::pending;
@@ -185,6 +185,13 @@ class GraspWorker {
     uint64_t cancelledBelow = 0;  // results of tickets below this are dropped
     std::optional<Done> done;
   };
+
+  // The spare pool: a job of a deforming target tops it up to kMinSpares before its refit, and
+  // at most kMaxSpares are kept (the app fills one, one waits, the worker applies one).
+  static constexpr size_t kMinSpares = 2;
+  static constexpr size_t kMaxSpares = 3;
+  // Moves `buffers` into the target's pool up to kMaxSpares (caller holds the mutex).
+  static void keepSpares(Target& target, std::vector<std::vector<glm::vec3>>& buffers);
 
   void run();
   void runSetup(std::unique_lock<std::mutex>& lock, uint64_t id, std::shared_ptr<Target> target);

@@ -393,6 +393,37 @@ TEST_CASE("A build stops at its WorkLimit and leaves the grid as it was", "[sdf_
   }
 }
 
+// The BVH's worst case, timed with and without the worker's default time bound (1 s): a soup of
+// large random triangles in a 12 cm cube, 16^3 exact build, one thread (as on the layer's
+// worker). Run: sdf_cpu_tests "[soup]".
+TEST_CASE("Timing of a build on a triangle soup, with and without a time bound",
+          "[.][timing][soup]") {
+  using Clock = std::chrono::steady_clock;
+  const auto seconds = [](Clock::duration d) { return std::chrono::duration<double>(d).count(); };
+  for (const uint32_t triangles : {35000u, 63000u}) {
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<float> coordinate(-0.06f, 0.06f);
+    TriangleMesh soup;
+    for (uint32_t i = 0; i < 3 * triangles; ++i) {
+      soup.positions.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng));
+      soup.indices.push_back(i);
+    }
+    const auto d = makeDistance(soup);
+    CpuSdfBuilder builder(1);
+    SdfGrid grid;
+    const GridBox box = GridBox::referenceDefault();
+    auto t0 = Clock::now();
+    const Status bounded = builder.build(*d, Pose{}, box, grid, CpuSdfOptions{},
+                                         WorkLimit::after(std::chrono::seconds(1)));
+    const double boundedSeconds = seconds(Clock::now() - t0);
+    t0 = Clock::now();
+    REQUIRE(builder.build(*d, Pose{}, box, grid) == Status::ok);
+    std::cout << triangles << "-triangle soup: " << seconds(Clock::now() - t0)
+              << " s unbounded; with a 1 s bound: " << toString(bounded) << " after "
+              << boundedSeconds << " s\n";
+  }
+}
+
 TEST_CASE("Timing of the far-field mode against exact builds", "[.][timing][far]") {
   using Clock = std::chrono::steady_clock;
   for (const char* name :

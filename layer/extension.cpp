@@ -62,9 +62,8 @@ XrResult verifyPlacement(const char* cmd, const SessionState& s,
 // Copies `n` positions from the app's array to `out` and bounds them; false when a coordinate
 // is NaN or infinite (then only `out` changed). The hot part of a vertex update, paid in every
 // frame of a deforming target: a memcpy, then one pass over the copy as floats in blocks of 12
-// (4 vertices, so lane j always holds axis j % 3) that the compiler vectorizes; about 3.5x
-// faster than a loop per vertex (0.24 against 0.83 ms for 200k vertices here). `check` turns NaN
-// at the first NaN or infinity: x - x is 0 for a finite x.
+// (4 vertices, so lane j always holds axis j % 3) that the compiler vectorizes, unlike a loop per
+// vertex. `check` turns NaN at the first NaN or infinity: x - x is 0 for a finite x.
 bool copyFinite(const XrVector3f* in, uint32_t n, glm::vec3* out, Aabb& bounds) {
   static_assert(sizeof(XrVector3f) == sizeof(glm::vec3));
   std::memcpy(static_cast<void*>(out), in, size_t(n) * sizeof(glm::vec3));
@@ -404,7 +403,8 @@ XrResult XRAPI_CALL SdfgXrUpdateGraspTargetVerticesSDFG(XrGraspTargetSDFG target
   // (no allocation, no fresh pages) and bound. A deforming mesh pays this every frame on the
   // app's thread; everything else is the worker's: the refit, and refusing positions that
   // collapse a triangle (the target keeps its last shape; updateGrasps logs it once). Checked
-  // here, that gather over every triangle took 1.5 to 6 ms of each frame at 400k triangles.
+  // here, that gather over every triangle was most of the 3.9 ms a frame the 400k-triangle
+  // armadillo's updates cost (docs/benchmarks.md, frame cost).
   std::vector<glm::vec3> positions = s->grasp->vertexBuffer(t->handle);
   if (XrResult r = copyVertices(cmd, v, t->vertexCount, positions, bounds); r != XR_SUCCESS)
     return r;

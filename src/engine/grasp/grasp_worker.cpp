@@ -253,8 +253,8 @@ void GraspWorker::runSetup(std::unique_lock<std::mutex>& lock, uint64_t id,
     error = "internal error";
   }
   // Two buffers for the app's first vertex updates, filled here so that the first updates of a
-  // deforming target neither allocate nor fault in fresh pages on the app's thread (1 to 2 ms
-  // for 200k vertices): the set-up's own positions, already in memory, and one more.
+  // deforming target neither allocate nor fault in fresh pages on the app's thread: the set-up's
+  // own positions, already in memory, and one more.
   std::vector<std::vector<glm::vec3>> spares;
   if (distance != nullptr) {
     try {

@@ -201,6 +201,44 @@ TEST_CASE("Grasp metrics report penetration, residual and early stops", "[core][
     CHECK(f.penetrationMm == 0.0f);
     CHECK_FALSE(f.passThrough);
   }
+  SECTION("The fingers are graded where the solver moved the hand (handCorrection)") {
+    // A tip touching a sphere at a known gap in the corrected hand frame; the correction moves
+    // the hand 2 cm. Graded in the placement's frame without the correction, the tip would be
+    // 2 cm from where it was put.
+    const float a = 0.4f, gap = 0.0015f, radius = 0.01f;
+    const Pose correction{glm::quat(1, 0, 0, 0), glm::vec3(0.0f, 0.02f, 0.0f)};
+    const glm::vec3 tip = hand.tipPosition(index, a);
+    const glm::vec3 centre = tip + tipDirection(hand, index, a) * (radius + rTip + gap);
+    auto q = queryOf(sphereAt(correction.transformPoint(centre), radius));
+    GraspResult g = allAt(0.0f);
+    g.handCorrection = correction;
+    g.fingers[int(index)].curl = a;
+    g.fingers[int(index)].jointCurls = {a, a, a, a};
+    g.fingers[int(index)].contact = true;
+    const FingerMetrics f = evaluateGrasp(*q, hand, identity, g).fingers[int(index)];
+    CHECK(f.tipGapMm == Approx(gap * 1000.0f).margin(0.1));
+    CHECK(f.contactResidualMm == Approx(gap * 1000.0f).margin(0.1));
+  }
+  SECTION("A thumb metacarpal that turns as the thumb closes is graded with its phalanges") {
+    // The thumb's metacarpal turns at its base (the others are fixed): a part pressed into its
+    // middle is penetration of the thumb, and the closest part there is its contact.
+    const Finger thumb = Finger::thumb;
+    const std::span<const Joint> joints = fingerJoints(thumb);
+    std::vector<Pose> poses(joints.size());
+    hand.fingerPose(thumb, 0.0f, poses);
+    const glm::vec3 mid = 0.5f * (poses[0].position + poses[1].position);
+    const float r = 0.5f * (hand.jointRadius(joints[0]) + hand.jointRadius(joints[1]));
+    const glm::vec3 bone = glm::normalize(poses[1].position - poses[0].position);
+    glm::vec3 side = glm::cross(bone, glm::vec3(0.0f, 1.0f, 0.0f));
+    side = glm::normalize(side);
+    const float depth = 0.002f, radius = 0.006f;
+    auto q = queryOf(sphereAt(mid + side * (r + radius - depth), radius));
+    GraspResult g = allAt(0.0f);
+    g.fingers[int(thumb)].contact = true;
+    const FingerMetrics f = evaluateGrasp(*q, hand, identity, g).fingers[int(thumb)];
+    CHECK(f.penetrationMm == Approx(depth * 1000.0f).margin(0.3));
+    CHECK(f.contactResidualMm == Approx(depth * 1000.0f).margin(0.3));
+  }
   SECTION("A finger whose sweep crosses a thin plate passes through; one stopped short does not") {
     // A 3 mm plate across the index tip's path at curl 0.5, square to the tip's motion there.
     const glm::vec3 at = hand.tipPosition(index, 0.5f);

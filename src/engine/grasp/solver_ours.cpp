@@ -307,9 +307,7 @@ Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {
       a = stage(st, curls, a, touching, point, value);
       if (scene.exact != nullptr) {
         const Clock::time_point t0 = Clock::now();
-        const int lastBone = touching >= 0 ? int(fr.spheres[touching].bone) : n - 1;
-        a = exactStop(cx, f, firstFree, lastBone, a, curls, touching, point, value,
-                      out.exactSamples);
+        a = exactStop(cx, f, firstFree, a, curls, touching, point, value, out.exactSamples);
         checkTime += Clock::now() - t0;
       }
       if (touching < 0) break;

@@ -143,9 +143,8 @@ class OursSolver final : public GraspSolver {
   void jointPositions(int finger, const JointCurls& curls,
                       std::array<glm::vec3, kMaxJoints + 1>& hand) const;
   struct ExactContext;
-  float exactStop(const ExactContext& cx, int finger, int firstFree, int lastBone, float a,
-                  JointCurls& curls, int& touching, glm::vec3& touchPoint, float& touchValue,
-                  int& samples) const;
+  float exactStop(const ExactContext& cx, int finger, int firstFree, float a, JointCurls& curls,
+                  int& touching, glm::vec3& touchPoint, float& touchValue, int& samples) const;
 
   HandModel hand_{};
   // The open hand's parts and its palm, for the clearance before the fingers close.

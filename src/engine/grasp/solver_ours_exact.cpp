@@ -18,19 +18,22 @@ struct ExactEval {
 }  // namespace
 
 // Corrects the curl of joints firstFree.. (which the field stopped at `a`) on the exact source.
-// Checked: the spheres on bones firstFree..lastBone (the ones this stop freezes) that the field
-// puts within kExactBand of touching, plus the touching one. A sphere's clearance is measured
-// against its own bone's capsule: the exact closest point q of its centre, its distance to the
-// bone's axis minus the capsule radius there (at most the centre's distance minus its radius;
-// it sees a bone that leans into the surface next to the centre). Secant steps on the smallest
-// clearance bring it into [0, kContactTolerance]. Closing past the field's stop is limited so
-// that no sphere left unchecked (distal ones included) moves more than its clearance on the
-// field; opening may go below where the group began (down to 0), which is how a sphere the
-// previous group left inside comes out. Spheres are re-chosen at every pose tried. The most
-// closed pose with no checked sphere inside is kept; if none was found, the group opens in
+// Checked: every sphere these joints move that the field puts within kExactBand of touching, plus
+// the touching one. All of them move together here, so whichever touches first on the exact
+// surface is the stop, proximal or distal: the field's order of contact can be wrong by its own
+// error, and checking only the field's touching bone and those before it left the distal ones to
+// limit how far the group may close, which crept toward the contact by halves and stopped short.
+// A sphere's clearance is measured against its own bone's capsule: the exact closest point q of its
+// centre, its distance to the bone's axis minus the capsule radius there (at most the centre's
+// distance minus its radius; it sees a bone that leans into the surface next to the centre). Secant
+// steps on the smallest clearance bring it into [0, kContactTolerance]. Closing past the field's
+// stop is limited so that no sphere left unchecked (one farther than the band) moves more than its
+// clearance on the field; opening may go below where the group began (down to 0), which is how a
+// sphere the previous group left inside comes out. Spheres are re-chosen at every pose tried. The
+// most closed pose with no checked sphere inside is kept; if none was found, the group opens in
 // doubling steps while that helps and the least inside pose is kept. Reports the closest sphere
 // as the touching one when it is within the tolerance (or when the field said it touched).
-float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int lastBone, float a,
+float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, float a,
                             JointCurls& curls, int& touching, glm::vec3& touchPoint,
                             float& touchValue, int& samples) const {
   const FingerRig& fr = fingers_[f];
@@ -63,10 +66,10 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
   // closest point (the distance's gradient) against its centre's velocity. NaN: none (the centre
   // was on the surface, or the search found nothing within its bound).
   std::array<float, kMaxSpheres> exactSlope{};
-  // Candidates are chosen on the field at every pose tried: a sphere of the frozen bones that
-  // comes within the band joins them. Every other moving sphere (distal ones too) limits how
-  // far the group may close from here: no more than its clearance on the field allows (the
-  // interpolant's slope bound), so none reaches the surface unseen. `highest`: that limit.
+  // Candidates are chosen on the field at every pose tried: a moving sphere that comes within
+  // the band joins them. Every other moving sphere limits how far the group may close from here: no
+  // more than its clearance on the field allows (the interpolant's slope bound), so none reaches
+  // the surface unseen. `highest`: that limit.
   float highest = 1.0f;
   // Each sphere's last trilinear clearance read here and its curl: the trilinear interpolant is
   // kInterpolantLipschitz-Lipschitz, so while that bound keeps a sphere beyond kExactBand +
@@ -96,7 +99,7 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
       if (g < kExactBand + kCorrectBand) {
         g = std::min(value, cx.sample->corrected(uvw, value)) - s.testRadius;
       }
-      if (s.bone <= lastBone && (g < kExactBand || i == touching)) {
+      if (g < kExactBand || i == touching) {
         isCand[i] = true;
         fresh[count] = true;
         lastA[count] = v;
@@ -162,8 +165,9 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
       }
     }
     if (found[0].distance > 0.0f) {
-      // The sphere at the proximal joint (bone 0, t = 1) starts the first phalanx's capsule.
-      const int b = s.bone == 0 ? 1 : s.bone;
+      // The sphere at the proximal joint (bone 0, t = 1) starts the first phalanx's capsule; the
+      // other spheres of bone 0 (a metacarpal that turns, the thumb's) lie on their own bone.
+      const int b = s.bone == 0 && s.t >= 1.0f ? 1 : s.bone;
       const glm::vec3 pa = cx.sceneFromHand.transformPoint(hand[b]);
       const glm::vec3 pb = cx.sceneFromHand.transformPoint(hand[b + 1]);
       const glm::vec3 axis = pb - pa;
@@ -284,10 +288,15 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
     const bool secant = !useNewton && havePrev && argPrev == cur.arg && aCur != aPrev;
     const float slope = secant ? (cur.g - gPrev) / (aCur - aPrev) : 0.0f;
     float next;
+    // Where the step predicts the closest sphere touches; NaN for the conservative steps, which
+    // predict nothing.
+    float root = std::numeric_limits<float>::quiet_NaN();
     if (useNewton) {
+      root = newton;
       next = std::min(newton, aCur + (std::max(cur.g, 0.0f) + kNewtonReach) / maxSpeed);
     } else if (slope < 0.0f) {
-      next = aCur + (0.5f * tol - cur.g) / slope;
+      root = aCur + (0.5f * tol - cur.g) / slope;
+      next = root;
     } else if (cur.g > 0.0f) {
       // The closest sphere does not come nearer as the group closes (it slides along
       // the surface): advance conservatively, no checked sphere moving more than its
@@ -311,11 +320,15 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, int la
     // A small last correction is taken without sampling it again: the step errs by a small
     // fraction of it (Newton: the curvature term above; a secant: more), so the pose lands
     // within that fraction of touching, and the other candidates' bounds keep them clear of it.
-    // (Only when the closest sphere is the one that set the step.)
+    // Only when the closest sphere is the one that set the step and the step reaches its
+    // predicted root: a step cut short (by the reach of the spheres left unchecked, by the
+    // Newton reach, or by a pose known to be inside) leaves the sphere short of the surface,
+    // and declaring it touching would stop the finger early.
     const float unverified = limiting == cur.arg ? kUnverifiedNewton
                              : useNewton         ? 0.0f
                                                  : kUnverifiedStep;
-    if (cur.arg >= 0 && std::abs(cur.g - 0.5f * tol) <= unverified && othersClear(next, cur.arg)) {
+    if (cur.arg >= 0 && next == root && std::abs(cur.g - 0.5f * tol) <= unverified &&
+        othersClear(next, cur.arg)) {
       setCurl(next);
       jointPositions(f, curls, hand);
       aSafe = next;

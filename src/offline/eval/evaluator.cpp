@@ -144,15 +144,26 @@ struct FingerChain {
   std::vector<float> radii;
 };
 
-// Samples the finger's capsules (proximal joint to tip) at the given joint curls.
-void sampleFinger(const HandModel& hand, Finger finger, const JointCurls& curls,
+// The first bone of the finger that moves as it curls: the metacarpal where it turns (the
+// thumb's, at its carpometacarpal joint), else the proximal phalanx. A moving metacarpal is a
+// part the finger can stop on or push into the object, so it is graded with the phalanges.
+size_t firstMovingBone(const HandModel& hand, Finger finger) {
+  const std::span<const Joint> joints = fingerJoints(finger);
+  std::array<Pose, 5> open{}, closed{};
+  hand.fingerPose(finger, 0.0f, std::span<Pose>(open.data(), joints.size()));
+  hand.fingerPose(finger, 1.0f, std::span<Pose>(closed.data(), joints.size()));
+  return glm::length(open[1].position - closed[1].position) > 1e-6f ? 0 : 1;
+}
+
+// Samples the finger's capsules (from its first moving bone to the tip) at the given joint curls.
+void sampleFinger(const HandModel& hand, Finger finger, size_t firstBone, const JointCurls& curls,
                   const Pose& objectFromHand, FingerChain& chain) {
   const std::span<const Joint> joints = fingerJoints(finger);
   std::array<Pose, 5> poses{};
   hand.fingerPose(finger, curls, std::span<Pose>(poses.data(), joints.size()));
   chain.points.clear();
   chain.radii.clear();
-  for (size_t j = 1; j + 1 < joints.size(); ++j) {
+  for (size_t j = firstBone; j + 1 < joints.size(); ++j) {
     const glm::vec3 a = objectFromHand.transformPoint(poses[j].position);
     const glm::vec3 b = objectFromHand.transformPoint(poses[j + 1].position);
     const float ra = hand.jointRadius(joints[j]);
@@ -196,7 +207,7 @@ ChainMeasure measureChain(const ExactMeshQuery& mesh, const FingerChain& chain,
 // samples is at most the sum of the chords, so querying a centre again only once its chord sum
 // exceeds u misses nothing that querying every step would find.
 bool sweepPassesThrough(const ExactMeshQuery& mesh, const HandModel& hand, Finger finger,
-                        const JointCurls& finalCurls, const Pose& objectFromHand,
+                        size_t firstBone, const JointCurls& finalCurls, const Pose& objectFromHand,
                         FingerChain& chain) {
   float top = 0.0f;
   for (float c : finalCurls) top = std::max(top, c);
@@ -207,7 +218,7 @@ bool sweepPassesThrough(const ExactMeshQuery& mesh, const HandModel& hand, Finge
     const float s = std::min(top, kPassThroughSweepStep * float(k));
     JointCurls curls{};
     for (size_t j = 0; j < curls.size(); ++j) curls[j] = std::min(s, finalCurls[j]);
-    sampleFinger(hand, finger, curls, objectFromHand, chain);
+    sampleFinger(hand, finger, firstBone, curls, objectFromHand, chain);
     if (budget.empty()) budget.assign(chain.points.size(), -1.0);
     for (size_t i = 0; i < chain.points.size() && i < budget.size(); ++i) {
       if (!previous.empty()) budget[i] -= double(glm::length(chain.points[i] - previous[i]));
@@ -238,10 +249,14 @@ GraspMetrics evaluateGrasp(const ExactMeshQuery& mesh, const HandModel& hand,
     out.penetrationMm = nan;
     return out;
   }
+  // The fingers closed in the hand frame the solver moved the hand to (GraspResult::
+  // handCorrection: the clearance, the approach), which is where the app shows them.
+  const Pose objectFromShown = objectFromHand * grasp.handCorrection;
   FingerChain chain;
   std::vector<double> scratch;
   for (int f = 0; f < kFingerCount; ++f) {
     const Finger finger = Finger(f);
+    const size_t firstBone = firstMovingBone(hand, finger);
     const FingerState& state = grasp.fingers[f];
     const double tipRadius = hand.tipRadius(finger);
     FingerMetrics& m = out.fingers[f];
@@ -249,7 +264,7 @@ GraspMetrics evaluateGrasp(const ExactMeshQuery& mesh, const HandModel& hand,
     // Curls outside [0, 1] or NaN (a broken solver) are graded as the pose they clamp to.
     JointCurls stopCurls = state.jointCurls;
     for (float& c : stopCurls) c = std::isfinite(c) ? std::clamp(c, 0.0f, 1.0f) : 0.0f;
-    sampleFinger(hand, finger, stopCurls, objectFromHand, chain);
+    sampleFinger(hand, finger, firstBone, stopCurls, objectFromShown, chain);
     const ChainMeasure at = measureChain(mesh, chain, scratch);
     m.contact = state.contact;
     m.stopped = state.contact || state.curl < 1.0f - 1e-6f;
@@ -261,7 +276,8 @@ GraspMetrics evaluateGrasp(const ExactMeshQuery& mesh, const HandModel& hand,
     m.touching = m.clearanceMm <= kTouchingMm;
     m.contactResidualMm = std::abs(m.clearanceMm);
     m.tipIsContact = m.tipGapMm <= m.clearanceMm + kTipContactToleranceMm;
-    m.passThrough = sweepPassesThrough(mesh, hand, finger, stopCurls, objectFromHand, chain);
+    m.passThrough =
+        sweepPassesThrough(mesh, hand, finger, firstBone, stopCurls, objectFromShown, chain);
 
     if (m.stopped && m.tipGapMm > kEarlyStopGapMm) {
       JointCurls curls = stopCurls;
@@ -271,7 +287,7 @@ GraspMetrics evaluateGrasp(const ExactMeshQuery& mesh, const HandModel& hand,
           curls[j] = std::min(1.0f, stopCurls[j] + kEarlyStopSweepStep * float(step));
           allClosed = allClosed && curls[j] >= 1.0f;
         }
-        sampleFinger(hand, finger, curls, objectFromHand, chain);
+        sampleFinger(hand, finger, firstBone, curls, objectFromShown, chain);
         const ChainMeasure next = measureChain(mesh, chain, scratch);
         if (next.penetration * 1000.0 > kSweepPenetrationToleranceMm) break;
         if ((next.tipDistance - tipRadius) * 1000.0 <= kEarlyStopGapMm) {

@@ -77,7 +77,7 @@ struct FingerMetrics {
   float tipDistanceMm = 0.0f;  // exact signed distance of the tip joint centre
   float tipGapMm = 0.0f;       // tipDistanceMm - r_tip (negative: tip sphere penetrates)
   float tipResidualMm = 0.0f;  // |tipGapMm|; meaningful only when `contact`
-  float penetrationMm = 0.0f;  // deepest phalanx capsule point inside the mesh, >= 0
+  float penetrationMm = 0.0f;  // deepest point of the finger's moving capsules inside, >= 0
   float clearanceMm = 0.0f;    // min over phalanx spheres of (d - r); <= kTouchingMm: touching
   bool touching = false;
   bool earlyStop = false;  // stopped with a tip gap > 5 mm though a closer pose existed
@@ -100,10 +100,13 @@ struct GraspMetrics {
 };
 
 // Metrics of one grasp. `objectFromHand` is the placement the solver saw (non-finite: every
-// float metric is NaN); curls are clamped to [0, 1], NaN read as 0; the finger poses come
-// from hand.fingerPose() at each finger's final jointCurls. Penetration is measured on capsules
-// from the proximal joint to the tip (joint radii, linearly interpolated along each bone), sampled
-// every kCapsuleSampleSpacing. Early stop: for a stopped finger with a tip gap > 5 mm, every joint
+// float metric is NaN); the fingers are graded in the hand frame the solver closed them in,
+// objectFromHand * grasp.handCorrection (where the app shows them). Curls are clamped to [0, 1],
+// NaN read as 0; the finger poses come from hand.fingerPose() at each finger's final jointCurls.
+// Penetration, clearance and contact residual are measured on the capsules of every bone that
+// moves as the finger curls, up to the tip: from the proximal joint, or from the metacarpal where
+// it turns (the thumb's), with joint radii linearly interpolated along each bone, sampled every
+// kCapsuleSampleSpacing. Early stop: for a stopped finger with a tip gap > 5 mm, every joint
 // curl is advanced by 0.01 per step (clamped to 1); the finger stopped early if some step brings
 // the tip gap to <= 5 mm before any capsule sphere penetrates by more than 0.1 mm.
 // Pass-through: s runs from 0 to the largest final joint curl in steps of kPassThroughSweepStep

@@ -23,10 +23,11 @@
 //   closest point against the centre's velocity), so a step errs only by the surface's
 //   curvature over the motion. The field's own polish is skipped then; without a source
 //   nothing changes. A candidate is not sampled while its field clearance minus kFieldTrust
-//   (solver_ours.cpp) cannot beat the closest one found, and each search is seeded with the
-//   sphere's last closest feature (ExactSample::feature). The field's stop is then only refined
-//   to 0.5 mm (the field's own error), and a last Newton step of at most 1 mm of clearance is
-//   taken without sampling it again, which saves about a fifth of the samples.
+//   (solver_ours_detail.h) cannot beat the closest one found, except at the poses where the stop
+//   is decided, where every candidate is; each search is seeded with the sphere's last closest
+//   feature (ExactSample::feature). The field's stop is then only refined to 0.5 mm (the field's
+//   own error). Every moving sphere within the band is a candidate, whichever bone it is on: the
+//   first to touch on the exact surface stops the group.
 // - Approach (optional, SolverOptions::approach): approachPose() follows the field's gradient
 //   from the palm to turn and move the hand onto the surface before the fingers close.
 // - Never inside (SolverOptions::clearance, on by default): an open hand with any part inside

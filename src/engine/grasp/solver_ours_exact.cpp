@@ -32,7 +32,8 @@ struct ExactEval {
 // sphere the previous group left inside comes out. Spheres are re-chosen at every pose tried. The
 // most closed pose with no checked sphere inside is kept; if none was found, the group opens in
 // doubling steps while that helps and the least inside pose is kept. Reports the closest sphere
-// as the touching one when it is within the tolerance (or when the field said it touched).
+// as the touching one when it is within the tolerance (or when the field said it touched, unless
+// the group closed fully and is clear of the exact surface: then nothing touches).
 float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, float a,
                             JointCurls& curls, int& touching, glm::vec3& touchPoint,
                             float& touchValue, int& samples) const {
@@ -228,14 +229,14 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, float 
     }
   };
 
-  // Whether every candidate but `arg` is certainly clear at curl v (bounds from the samples).
-  auto othersClear = [&](float v, int arg) {
+  // Samples, at the current joint positions (curl v), every candidate never sampled exactly yet:
+  // until then its bound is its field clearance minus kFieldTrust, which a part thinner than the
+  // field resolves (a spike, a thin rim) can beat by millimetres. Before a pose is taken as the
+  // stop, every candidate's bound comes from an exact sample.
+  auto verifyFresh = [&](float v, ExactEval& r) {
     for (int k = 0; k < count; ++k) {
-      if (cand[k] != arg && lastG[k] - speed[cand[k]] * std::abs(v - lastA[k]) < 0.0f) {
-        return false;
-      }
+      if (fresh[k]) sampleOne(k, v, r);
     }
-    return true;
   };
 
   ExactEval cur;
@@ -248,9 +249,15 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, float 
   bool havePrev = false;
   int argPrev = -1;
   float aSafe = -1.0f, aOpen = a;  // most closed pose with nothing inside; most open tried
+  // The least closed pose tried that had a candidate inside, above aSafe: the contact lies
+  // between the two, and no step goes to or past it.
+  float aInside = std::numeric_limits<float>::infinity();
   ExactEval safe, open = cur, least = cur;
   float aLeast = a;  // the pose with the largest clearance tried
   for (int it = 0;; ++it) {
+    // A pose near enough to end the search is first checked against every candidate.
+    if (cur.g >= 0.0f && cur.g <= kVerifyBand) verifyFresh(aCur, cur);
+    if (cur.g < 0.0f && aCur > aSafe) aInside = std::min(aInside, aCur);
     if (cur.g >= 0.0f && aCur > aSafe) {
       aSafe = aCur;
       safe = cur;
@@ -288,15 +295,10 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, float 
     const bool secant = !useNewton && havePrev && argPrev == cur.arg && aCur != aPrev;
     const float slope = secant ? (cur.g - gPrev) / (aCur - aPrev) : 0.0f;
     float next;
-    // Where the step predicts the closest sphere touches; NaN for the conservative steps, which
-    // predict nothing.
-    float root = std::numeric_limits<float>::quiet_NaN();
     if (useNewton) {
-      root = newton;
       next = std::min(newton, aCur + (std::max(cur.g, 0.0f) + kNewtonReach) / maxSpeed);
     } else if (slope < 0.0f) {
-      root = aCur + (0.5f * tol - cur.g) / slope;
-      next = root;
+      next = aCur + (0.5f * tol - cur.g) / slope;
     } else if (cur.g > 0.0f) {
       // The closest sphere does not come nearer as the group closes (it slides along
       // the surface): advance conservatively, no checked sphere moving more than its
@@ -316,28 +318,11 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, float 
     // Never close past a pose known to be inside, nor open past one known to be
     // clear.
     if (aSafe >= 0.0f && next < aSafe) next = aSafe + 0.5f * (aCur - aSafe);
+    // Nor, from a pose below it, to or past one known to be inside: the step's prediction is
+    // wrong there (bisect). From an inside pose itself any step is taken: a sphere can come out
+    // as the group closes (a part behind the finger).
+    if (aCur < aInside && next >= aInside) next = 0.5f * (aCur + aInside);
     if (std::abs(next - aCur) < 1e-7f) break;
-    // A small last correction is taken without sampling it again: the step errs by a small
-    // fraction of it (Newton: the curvature term above; a secant: more), so the pose lands
-    // within that fraction of touching, and the other candidates' bounds keep them clear of it.
-    // Only when the closest sphere is the one that set the step and the step reaches its
-    // predicted root: a step cut short (by the reach of the spheres left unchecked, by the
-    // Newton reach, or by a pose known to be inside) leaves the sphere short of the surface,
-    // and declaring it touching would stop the finger early.
-    const float unverified = limiting == cur.arg ? kUnverifiedNewton
-                             : useNewton         ? 0.0f
-                                                 : kUnverifiedStep;
-    if (cur.arg >= 0 && next == root && std::abs(cur.g - 0.5f * tol) <= unverified &&
-        othersClear(next, cur.arg)) {
-      setCurl(next);
-      jointPositions(f, curls, hand);
-      aSafe = next;
-      safe = cur;
-      safe.centre = centreOf(fr.spheres[cur.arg]);
-      safe.distance = cur.distance - (cur.g - 0.5f * tol);
-      safe.g = 0.5f * tol;
-      break;
-    }
     aPrev = aCur;
     gPrev = cur.g;
     argPrev = cur.arg;
@@ -367,6 +352,12 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, float 
     safe = least;
   }
   setCurl(aSafe);
+  // Fully closed and clear of the exact surface: the field's contact was its own error, and the
+  // finger touches nothing (it would otherwise report a contact millimetres off the surface).
+  if (aSafe >= 1.0f && safe.g > tol) {
+    touching = -1;
+    return aSafe;
+  }
   if (safe.arg >= 0 && (touching >= 0 || safe.g <= tol)) {
     touching = safe.arg;
     touchPoint = safe.centre;

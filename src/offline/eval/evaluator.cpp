@@ -105,15 +105,19 @@ double ExactMeshQuery::signedDistance(const glm::vec3& p) const {
   return inside(p) ? -d : d;
 }
 
-void ExactMeshQuery::signedDistances(std::span<const glm::vec3> points,
-                                     std::span<double> out) const {
+// The chain walk behind signedDistances() and anyWithin(): writes each point's signed distance
+// to `out` (when not empty) and stops early once `stop(i, distance)` says so. Returns the number
+// of points walked.
+template <class Stop>
+size_t ExactMeshQuery::walkChain(std::span<const glm::vec3> points, std::span<double> out,
+                                 Stop stop) const {
   bool previousInside = false;
   double previousDistance = 0.0;
   Point3 hint;
   bool haveHint = false;
-  for (size_t i = 0; i < points.size() && i < out.size(); ++i) {
+  for (size_t i = 0; i < points.size(); ++i) {
     if (!allFinite(points[i])) {
-      out[i] = std::numeric_limits<double>::quiet_NaN();
+      if (i < out.size()) out[i] = std::numeric_limits<double>::quiet_NaN();
       previousDistance = 0.0;  // the next point casts its own rays
       continue;
     }
@@ -131,10 +135,29 @@ void ExactMeshQuery::signedDistances(std::span<const glm::vec3> points,
     } else {
       isInside = d > 0.0 && inside(points[i]);
     }
-    out[i] = isInside ? -d : d;
+    const double signedDistance = isInside ? -d : d;
+    if (i < out.size()) out[i] = signedDistance;
     previousInside = isInside;
     previousDistance = d;
+    if (stop(i, signedDistance)) return i + 1;
   }
+  return points.size();
+}
+
+void ExactMeshQuery::signedDistances(std::span<const glm::vec3> points,
+                                     std::span<double> out) const {
+  walkChain(points.first(std::min(points.size(), out.size())), out,
+            [](size_t, double) { return false; });
+}
+
+bool ExactMeshQuery::anyWithin(std::span<const glm::vec3> points,
+                               std::span<const float> radii) const {
+  bool found = false;
+  walkChain(points.first(std::min(points.size(), radii.size())), {}, [&](size_t i, double d) {
+    found = d < double(radii[i]);
+    return found;
+  });
+  return found;
 }
 
 namespace {

@@ -48,9 +48,16 @@ class ExactMeshQuery {
   // from each other, so rays are cast only where the chain comes near the surface.
   void signedDistances(std::span<const glm::vec3> points, std::span<double> out) const;
 
+  // Whether some point of a chain (as signedDistances()) has a signed distance below its radius:
+  // a sphere that touches or enters the mesh. Stops at the first one, so a chain that does is
+  // cheaper to refuse than to measure whole.
+  bool anyWithin(std::span<const glm::vec3> points, std::span<const float> radii) const;
+
   static constexpr int kInsideRays = 7;
 
  private:
+  template <class Stop>
+  size_t walkChain(std::span<const glm::vec3> points, std::span<double> out, Stop stop) const;
   struct Impl;
   explicit ExactMeshQuery(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;

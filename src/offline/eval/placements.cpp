@@ -57,12 +57,7 @@ bool openHandIntersects(const ExactMeshQuery& query, const HandModel& hand,
                     hand.jointRadius(chain[j + 1]), points, radii);
     }
   }
-  std::vector<double> distances(points.size());
-  query.signedDistances(points, distances);
-  for (size_t i = 0; i < points.size(); ++i) {
-    if (distances[i] < double(radii[i])) return true;
-  }
-  return false;
+  return query.anyWithin(points, radii);
 }
 
 std::vector<Placement> generatePlacements(const TriangleMesh& normalizedMesh,

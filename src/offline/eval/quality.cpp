@@ -1,0 +1,134 @@
+#include "eval/quality.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "eval/evaluator.h"
+#include "eval/placements.h"
+#include "mesh/mesh_distance.h"
+#include "sdf/sdf_cpu.h"
+
+namespace sdfg {
+
+namespace {
+
+// Linear interpolation between order statistics, as the benchmark's tables.
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * double(v.size() - 1);
+  const size_t lo = size_t(std::floor(pos));
+  const size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (v[hi] - v[lo]) * (pos - double(lo));
+}
+
+struct Graded {
+  GraspMetrics metrics;
+  std::optional<Error> error;
+};
+
+}  // namespace
+
+Result<QualityFigures> measureQuality(const TriangleMesh& original, const QualityRun& run) {
+  if (auto error = validateMesh(original.positions, original.indices)) {
+    return makeError(error->code, error->message);
+  }
+  if (run.placements <= 0 || run.threads == 0) {
+    return makeError(Status::invalid_argument, "quality: placements and threads must be positive");
+  }
+  const TriangleMesh mesh = normalizedToDiagonal(original, kBenchObjectDiagonal);
+  auto distance = MeshDistance::create(mesh);
+  if (!distance) return distance.error();
+  auto exact = ExactMeshQuery::create(mesh);
+  if (!exact) return exact.error();
+  const HandModel hand = HandModel::defaultAdult(Hand::right);
+
+  // One solver per thread: solve() is const, but nothing promises a strategy is reentrant.
+  std::vector<std::unique_ptr<GraspSolver>> solvers;
+  for (unsigned t = 0; t < run.threads; ++t) {
+    auto solver = createSolver(run.method);
+    if (!solver) return solver.error();
+    if (!(*solver)->needsField()) {
+      return makeError(Status::invalid_argument, "quality: " + run.method +
+                                                     " does not read the SDF (physics strategies "
+                                                     "are measured by autograsp-bench)");
+    }
+    if (Status s = (*solver)->prepare(hand, run.box, run.options); s != Status::ok) {
+      return makeError(s, "quality: " + std::string((*solver)->prepareError()));
+    }
+    solvers.push_back(std::move(*solver));
+  }
+
+  const std::vector<Placement> placements =
+      generatePlacements(mesh, **exact, hand, run.box, run.placements, run.seed);
+  if (placements.size() < size_t(run.placements)) {
+    return makeError(Status::invalid_argument,
+                     "quality: only " + std::to_string(placements.size()) + " of " +
+                         std::to_string(run.placements) + " placements have room for an open hand");
+  }
+
+  std::vector<Graded> graded(placements.size());
+  std::atomic<size_t> next{0};
+  auto work = [&](unsigned t) {
+    CpuSdfBuilder builder(1);
+    SdfGrid grid(run.box);
+    GraspResult result;
+    for (size_t p = next++; p < placements.size(); p = next++) {
+      const Pose& objectFromHand = placements[p].objectFromHand;
+      if (Status s = builder.build(**distance, objectFromHand, run.box, grid); s != Status::ok) {
+        graded[p].error = makeError(s, "SDF build failed on placement " + std::to_string(p));
+        continue;
+      }
+      const MeshExactSource exactSource(**distance, objectFromHand);
+      GraspScene scene;
+      scene.field = &grid;
+      scene.objectFromHand = objectFromHand;
+      scene.exact = run.exactCheck ? &exactSource : nullptr;
+      if (Status s = solvers[t]->solve(scene, result); s != Status::ok) {
+        graded[p].error = makeError(s, run.method + ": solve failed on placement " +
+                                           std::to_string(p) + " (" + toString(s) + ")");
+        continue;
+      }
+      graded[p].metrics = evaluateGrasp(**exact, hand, objectFromHand, result);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < run.threads; ++t) pool.emplace_back(work, t);
+  work(0);
+  for (std::thread& th : pool) th.join();
+
+  QualityFigures out;
+  std::vector<double> residuals, penetrations;
+  int touching = 0;
+  for (size_t p = 0; p < graded.size(); ++p) {
+    if (graded[p].error) return *graded[p].error;
+    const GraspMetrics& m = graded[p].metrics;
+    ++out.grasps;
+    penetrations.push_back(m.penetrationMm);
+    if (m.penetrationMm > out.penetrationMaxMm || out.deepestPlacement < 0) {
+      out.penetrationMaxMm = m.penetrationMm;
+      out.deepestPlacement = int(p);
+    }
+    out.earlyStops += m.earlyStops;
+    if (m.earlyStops > 0 && out.earlyStopPlacement < 0) out.earlyStopPlacement = int(p);
+    out.passThroughs += m.passThroughs;
+    touching += m.contacts;
+    for (const FingerMetrics& f : m.fingers) {
+      if (!f.contact) continue;
+      residuals.push_back(f.contactResidualMm);
+    }
+  }
+  out.fingersInContact = int(residuals.size());
+  out.contactResidualMedianMm = percentile(residuals, 0.5);
+  out.contactResidualP95Mm = percentile(residuals, 0.95);
+  out.penetrationP99Mm = percentile(penetrations, 0.99);
+  out.contactsPerGrasp = out.grasps > 0 ? double(touching) / out.grasps : 0.0;
+  return out;
+}
+
+}  // namespace sdfg

@@ -1,0 +1,59 @@
+// A strategy's grasp quality on one object, in the figures the benchmark publishes and the
+// quality tests gate (DESIGN.md section 4): contact residual, penetration, early stops, contacts.
+//
+// measureQuality() runs the benchmark's own procedure without its timing: the object scaled to
+// the bench's size, the seeded placements (eval/placements.h), a CPU grab-box SDF per placement,
+// the strategy's solve (with the exact check where it reads one), and evaluateGrasp() on the
+// exact mesh. Every figure is a pure function of the mesh, the settings and the seed (placements
+// are graded independently, so the thread count changes nothing), which is what lets a test hold
+// them to published values.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "base/status.h"
+#include "grasp/solver.h"
+#include "mesh/mesh.h"
+#include "sdf/sdf_grid.h"
+
+namespace sdfg {
+
+// Every object of the benchmark is scaled to this bounding-box diagonal (a hand-sized object).
+inline constexpr float kBenchObjectDiagonal = 0.18f;  // metres
+
+struct QualityRun {
+  std::string method = "ours";  // an SDF strategy of createSolver()
+  int placements = 1000;
+  uint64_t seed = 1;
+  unsigned threads = 1;  // placements solved and graded at once; no effect on the figures
+  SolverOptions options{};
+  bool exactCheck = true;  // GraspScene::exact for the strategies that read it
+  GridBox box = GridBox::referenceDefault();
+};
+
+// Figures in millimetres over the placements' grasps (residuals over fingers in contact).
+struct QualityFigures {
+  int grasps = 0;
+  int fingersInContact = 0;
+  double contactResidualMedianMm = 0.0;
+  double contactResidualP95Mm = 0.0;
+  double penetrationP99Mm = 0.0;  // over grasps (each grasp's deepest finger)
+  double penetrationMaxMm = 0.0;
+  int earlyStops = 0;
+  double contactsPerGrasp = 0.0;  // fingers touching (within kTouchingMm), mean per grasp
+  int passThroughs = 0;
+  // The grasp with the deepest penetration and one with an early stop (-1: none), for a failing
+  // test to name.
+  int deepestPlacement = -1;
+  int earlyStopPlacement = -1;
+
+  double earlyStopsPer1000() const { return grasps > 0 ? 1000.0 * earlyStops / grasps : 0.0; }
+};
+
+// Runs `run` on `mesh` (any size and place: it is scaled to kBenchObjectDiagonal). Errors: an
+// invalid mesh, an unknown or non-SDF strategy, invalid options, fewer placements found than
+// asked (a mesh with no room for an open hand), or a failed build or solve (named).
+Result<QualityFigures> measureQuality(const TriangleMesh& mesh, const QualityRun& run);
+
+}  // namespace sdfg

@@ -1,0 +1,140 @@
+// "ours" meets its published quality on every object it is published for: the embedded objects
+// always, the research meshes of ../shared/meshes where they are present. Quality figures are
+// deterministic for a seed (eval/quality.h), so these are tests, not timings: a change to the
+// solver, the field, the hand model or the evaluator that worsens one fails here.
+//
+// Gates, the same for every object (the project's published targets): contact residual median
+// <= 0.1 mm and p95 <= 0.15 mm, penetration <= 0.5 mm at every placement, early stops <= 5 per
+// 1000, no finger passing through; and per object, contacts per grasp no lower than measured at
+// the commit that set the gate (see kObjects). Each object is its own test case, so an absent
+// research mesh is skipped before any assertion and a present one is judged. Each case prints
+// its figures (a passing run's log shows them).
+#include <catch2/catch.hpp>
+
+#include <cstdio>
+#include <optional>
+#include <string>
+
+#include "eval/quality.h"
+#include "io/mesh_io.h"
+#include "io/shapes.h"
+#include "test_support.h"
+
+using namespace sdfg;
+
+namespace {
+
+constexpr double kResidualMedianMm = 0.10;
+constexpr double kResidualP95Mm = 0.15;
+constexpr double kPenetrationMaxMm = 0.5;
+constexpr double kEarlyStopsPer1000 = 5.0;
+constexpr uint64_t kSeed = 1;
+// Both cores: the figures do not depend on the thread count.
+constexpr unsigned kThreads = 2;
+
+struct Gate {
+  int placements;
+  // Contacts per grasp (fingers within 2 mm, eval/evaluator.h) no lower than this.
+  double contactsPerGrasp;
+};
+
+// The embedded objects run the published 1000 placements. The research meshes run the first 250
+// of the same seeded sequence, so the label stays within a minute or two on the 2-core machine.
+// Contacts per grasp: measured at the commit that fixed caa7400's regression, rounded down. Against
+// docs/benchmarks.md of 2026-11-22 (1000 placements, before the hand's clearance) the embedded
+// objects are higher (mug 4.777 vs 4.75, torus 4.649 vs 4.59, thin plate 4.604 vs 4.52: the
+// thumb's metacarpal now counts), the teapot and Igea lower by 0.007 and 0.003 (a hand whose open
+// palm was inside is moved out before closing, and a finger that grazed the surface from the old
+// pose misses it from the new one).
+constexpr Gate kMug{1000, 4.77};
+constexpr Gate kTorus{1000, 4.64};
+constexpr Gate kThinPlate{1000, 4.60};
+
+void checkQuality(const std::string& name, const TriangleMesh& mesh, const Gate& gate) {
+  QualityRun run;
+  run.placements = gate.placements;
+  run.seed = kSeed;
+  run.threads = kThreads;
+  const Result<QualityFigures> measured = measureQuality(mesh, run);
+  REQUIRE(measured.ok());
+  const QualityFigures& q = *measured;
+  std::printf(
+      "%s: %d grasps; contact residual median %.4f mm, p95 %.4f mm; penetration p99 %.3f mm, max "
+      "%.3f mm (placement %d); early stops %d (%.1f per 1000); contacts per grasp %.3f; pass "
+      "through %d\n",
+      name.c_str(), q.grasps, q.contactResidualMedianMm, q.contactResidualP95Mm, q.penetrationP99Mm,
+      q.penetrationMaxMm, q.deepestPlacement, q.earlyStops, q.earlyStopsPer1000(),
+      q.contactsPerGrasp, q.passThroughs);
+  INFO(name << ", seed " << kSeed << ": deepest penetration at placement " << q.deepestPlacement
+            << ", an early stop at placement " << q.earlyStopPlacement);
+  CHECK(q.grasps == gate.placements);
+  CHECK(q.contactResidualMedianMm <= kResidualMedianMm);
+  CHECK(q.contactResidualP95Mm <= kResidualP95Mm);
+  CHECK(q.penetrationMaxMm <= kPenetrationMaxMm);
+  CHECK(q.earlyStopsPer1000() <= kEarlyStopsPer1000);
+  CHECK(q.contactsPerGrasp >= gate.contactsPerGrasp);
+  CHECK(q.passThroughs == 0);
+}
+
+void checkEmbedded(const std::string& name, const Gate& gate) {
+  std::optional<TriangleMesh> mesh;
+  for (const NamedMesh& o : embeddedObjects()) {
+    if (o.name == name) mesh = o.mesh;
+  }
+  REQUIRE(mesh.has_value());
+  checkQuality(name, *mesh, gate);
+}
+
+}  // namespace
+
+// A research mesh of ../shared/meshes, or a skip (before any assertion) where it is absent.
+#define SDFG_CHECK_SHARED(file, gate)                                                   \
+  do {                                                                                  \
+    const auto path = test::sharedMesh(file);                                           \
+    if (!path) SDFG_SKIP(std::string(file) + ": ../shared/meshes is not present here"); \
+    const Result<LoadedMesh> loaded = loadMesh(*path);                                  \
+    REQUIRE(loaded.ok());                                                               \
+    checkQuality(file, loaded->mesh, gate);                                             \
+  } while (false)
+
+TEST_CASE("ours meets its published quality on the embedded mug", "[quality]") {
+  checkEmbedded("mug", kMug);
+}
+
+TEST_CASE("ours meets its published quality on the embedded torus", "[quality]") {
+  checkEmbedded("torus", kTorus);
+}
+
+TEST_CASE("ours meets its published quality on the embedded thin plate", "[quality]") {
+  checkEmbedded("thin-plate", kThinPlate);
+}
+
+TEST_CASE("ours meets its published quality on the Stanford bunny", "[quality][shared]") {
+  SDFG_CHECK_SHARED("stanford-bunny.obj", (Gate{250, 4.75}));
+}
+
+TEST_CASE("ours meets its published quality on the Newell teapot", "[quality][shared]") {
+  SDFG_CHECK_SHARED("newell-teapot.obj", (Gate{250, 4.84}));
+}
+
+TEST_CASE("ours meets its published quality on the torus mesh", "[quality][shared]") {
+  SDFG_CHECK_SHARED("torus.obj", (Gate{250, 4.56}));
+}
+
+TEST_CASE("ours meets its published quality on the Stanford armadillo (100k)",
+          "[quality][shared]") {
+  SDFG_CHECK_SHARED("stanford-armadillo-100k.obj", (Gate{250, 4.44}));
+}
+
+TEST_CASE("ours meets its published quality on the Stanford armadillo (400k)",
+          "[quality][shared]") {
+  SDFG_CHECK_SHARED("stanford-armadillo-400k-subdiv.obj", (Gate{250, 4.43}));
+}
+
+TEST_CASE("ours meets its published quality on the Stanford dragon", "[quality][shared]") {
+  SDFG_CHECK_SHARED("stanford-dragon-100k.ply", (Gate{250, 4.26}));
+}
+
+TEST_CASE("ours meets its published quality on the Igea scan (268k)", "[quality][shared]") {
+  SDFG_CHECK_SHARED("igea-268k.obj", (Gate{250, 4.88}));
+}

@@ -108,10 +108,6 @@ std::optional<Error> writeScalingJson(const std::filesystem::path& file,
 // A sweep written by writeScalingJson(). Errors: io_error naming the file and the problem.
 Result<ScalingResults> readScalingJson(const std::filesystem::path& file);
 
-// JSON text of a string (quoted, escaped) and of a number ("null" when not finite, else %.6g).
-std::string jsonString(const std::string& s);
-std::string jsonNumber(double v);
-
 // Where --report puts the bench's JSON when --json is not given (creates the folder).
 std::filesystem::path reportResultsPath(const std::filesystem::path& dir);
 

@@ -1,0 +1,41 @@
+#include "json_file.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+namespace sdfg::tools {
+
+Json jsonNumber(double v) {
+  if (!std::isfinite(v)) return nullptr;
+  // Through the decimal text: nlohmann writes the shortest form that reads back to the same
+  // double, so 0.1f is written as 0.1, not 0.10000000149011612.
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return std::strtod(text, nullptr);
+}
+
+std::optional<Error> writeJsonFile(const std::filesystem::path& file, const Json& value) {
+  std::ofstream out(file);
+  if (!out) return makeError(Status::io_error, file.string() + ": cannot write");
+  out << value.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+  out.flush();
+  if (!out) return makeError(Status::io_error, file.string() + ": cannot write");
+  return std::nullopt;
+}
+
+Result<Json> readJsonFile(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) return makeError(Status::io_error, file.string() + ": cannot read");
+  std::stringstream text;
+  text << in.rdbuf();
+  try {
+    return Json::parse(text.str());
+  } catch (const Json::parse_error& e) {
+    return makeError(Status::io_error, file.string() + ": " + e.what());
+  }
+}
+
+}  // namespace sdfg::tools

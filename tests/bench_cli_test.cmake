@@ -232,9 +232,11 @@ if(NOT rows EQUAL 1 OR NOT mesh STREQUAL "cube")
 endif()
 check_row("${json}" 0 3)
 
-# 3. Bad option values are usage errors.
+# 3. Bad option values are usage errors: out of range, not decimal (010 and 0x10 are not read as
+# octal or hexadecimal), a negative seed, two values after a single --mesh.
 foreach(args "--placements;abc" "--methods;nope" "--resolution;1" "--da;0" "--bogus"
-    "--sdf-backend;gpu" "--sdf-backend;," "--exact-check;maybe" "--exact-check")
+    "--sdf-backend;gpu" "--sdf-backend;," "--exact-check;maybe" "--exact-check"
+    "--placements;0x10" "--seed;-1" "--da;nan" "--mesh;a.obj;b.obj" "--json;")
   execute_process(COMMAND "${BENCH}" ${args} RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
   if(NOT rc EQUAL 2 OR NOT err MATCHES "usage")
     message(FATAL_ERROR "\"${args}\" exited ${rc}, expected 2 with usage:\n${err}")

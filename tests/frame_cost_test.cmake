@@ -1,6 +1,7 @@
 # Smoke test of autograsp-frame-cost (label layer): one embedded object, a few frames per phase,
 # through the real loader, the mock runtime and the layer. Checks the run succeeds and its JSON
-# has every key docs/benchmarks.md quotes; timings are the benchmark's business, not a test's.
+# has every key docs/benchmarks.md quotes, and that a bad option value is a usage error; timings
+# are the benchmark's business, not a test's.
 # Inputs: -DTOOL=<autograsp-frame-cost> -DWORK=<scratch folder>
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
@@ -53,4 +54,9 @@ foreach(call xrWaitFrame xrBeginFrame xrSyncActions xrLocateHandJointsEXT xrEndF
     message(FATAL_ERROR "JSON lacks the timing of ${call}: ${e}")
   endif()
 endforeach()
+# A bad option value is a usage error (exit 2) naming the value.
+execute_process(COMMAND ${TOOL} --frames 5x RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "--frames: \"5x\" is not an integer" OR NOT err MATCHES "usage")
+  message(FATAL_ERROR "--frames 5x: exit ${rc}, expected 2 with usage:\n${err}")
+endif()
 message(STATUS "frame-cost JSON complete (mug, grab latency ${latency} frames)")

@@ -15,12 +15,7 @@
 // shown; its length is the grab latency in frames), held (still), held moving (30 degrees over 60
 // frames about the object's vertical axis), held deforming (vertices rescaled every frame).
 //
-// Usage: autograsp-frame-cost [--embedded-only] [--frames N] [--json FILE] [--mesh NAME]...
-//   --frames N       frames per phase (default 60; the smoke test uses a few)
-//   --embedded-only  skip ../shared/meshes (the bunny and the armadillos)
-//   --only NAME      measure only the object called NAME (repeatable)
-//   --json FILE      write the results (default docs/results/frame-cost.json is not assumed:
-//                    without --json nothing is written)
+// Options: kUsage below (--help prints it).
 #include <openxr/openxr.h>
 
 #include <openxr/XR_SDFG_auto_grasp.h>
@@ -33,6 +28,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -42,6 +38,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "cli_options.h"
 #include "frame_cost_config.h"
 #include "hand/hand_model.h"
 #include "hand/hand_synthesis.h"
@@ -58,6 +55,16 @@ using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
 constexpr auto kFramePeriod = std::chrono::nanoseconds(11'111'111);  // 90 Hz
+
+const char* const kUsage =
+    "usage: autograsp-frame-cost [--frames N] [--embedded-only] [--only NAME]... [--json FILE]\n"
+    "  --frames N       frames per phase (default 60, at least 2; the smoke test uses a few)\n"
+    "  --embedded-only  skip ../shared/meshes (the bunny and the armadillos)\n"
+    "  --only NAME      measure only the object called NAME (repeatable)\n"
+    "  --json FILE      write the results as JSON (without it nothing is written)\n"
+    "  --help           this text\n"
+    "exit codes: 0 every object measured; 1 an object failed or the JSON could not be written;\n"
+    "2 bad option\n";
 
 double ms(Clock::duration d) {
   return std::chrono::duration<double, std::milli>(d).count();
@@ -463,26 +470,27 @@ RunResult run(const Object& object, bool layer, int phaseFrames) {
 
 int main(int argc, char** argv) {
   int phaseFrames = 60;
-  bool embeddedOnly = false;
+  bool embeddedOnly = false, help = false;
   std::string json;
-  std::set<std::string> only;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--frames" && i + 1 < argc) {
-      phaseFrames = std::max(2, std::atoi(argv[++i]));
-    } else if (a == "--embedded-only") {
-      embeddedOnly = true;
-    } else if (a == "--json" && i + 1 < argc) {
-      json = argv[++i];
-    } else if (a == "--only" && i + 1 < argc) {
-      only.insert(argv[++i]);
-    } else {
-      std::fprintf(stderr,
-                   "usage: autograsp-frame-cost [--frames N] [--embedded-only] [--only NAME]... "
-                   "[--json FILE]\n");
-      return 2;
-    }
+  std::vector<std::string> onlyNames;
+  CLI::App cli{"", "autograsp-frame-cost"};
+  sdfg::tools::cli::addHelpFlag(cli, help);
+  // Fewer than 2 frames per phase leave nothing to take percentiles of: raised to 2, as always.
+  sdfg::tools::cli::addInteger(
+      cli, "--frames", std::numeric_limits<int>::min(), std::numeric_limits<int>::max(),
+      [&](long long n) { phaseFrames = std::max(2, int(n)); }, "an integer");
+  cli.add_flag("--embedded-only", embeddedOnly);
+  sdfg::tools::cli::addName(cli, "--json", json, "file name");
+  sdfg::tools::cli::addRepeatable(cli, "--only", onlyNames);
+  if (auto error = sdfg::tools::cli::parse(cli, argc, argv)) {
+    std::fprintf(stderr, "autograsp-frame-cost: %s\n%s", error->c_str(), kUsage);
+    return 2;
   }
+  if (help) {
+    std::fputs(kUsage, stdout);
+    return 0;
+  }
+  const std::set<std::string> only(onlyNames.begin(), onlyNames.end());
   if (std::getenv("XR_RUNTIME_JSON") == nullptr)
     setenv("XR_RUNTIME_JSON", SDFG_FC_MOCK_RUNTIME_JSON, 1);
   setenv("SDFG_MOCK_HAND_TRACKING", "absent", 1);  // controllers only: the layer makes the hands

@@ -1,6 +1,7 @@
 # Drives autograsp-sdf-scaling like a user, on the CPU builder only (the loader pointed at no
 # Vulkan driver, so the run is the same on every machine): --help prints the usage and exits 0,
-# bad option values exit 2 naming the value, and a tiny run prints its table.
+# bad option values exit 2 naming the value, and a tiny run prints its table under a header that
+# names the commit of the code.
 # Usage: cmake -DTOOL=<autograsp-sdf-scaling> -DWORK=<scratch dir> -P sdf_scaling_test.cmake
 cmake_minimum_required(VERSION 3.25)
 if(NOT TOOL OR NOT WORK)
@@ -31,6 +32,9 @@ execute_process(COMMAND "${CMAKE_COMMAND}" -E env ${no_driver} "${TOOL}" --quick
   --only torus RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "the CPU-only run exited ${rc}\n${out}\n${err}")
+endif()
+if(NOT out MATCHES "\n# code at commit ([0-9a-f]+ \\((clean|modified)|unknown )")
+  message(FATAL_ERROR "the output does not name the commit of the code:\n${out}")
 endif()
 string(REGEX MATCHALL "\n\\| torus-[0-9]+ \\| [0-9]+ \\| 8\\^3 \\| [0-9.]+ \\|" rows "${out}")
 list(LENGTH rows n)

@@ -2,7 +2,7 @@
 # The demo test: autograsp-demo on a small setting (embedded objects, 512 px panels) plus a broken
 # mesh file. The broken file must get a clear message naming it, the run must go on and grasp
 # every embedded object, and exit 1 (something was skipped); then autograsp-demo-check checks
-# the pictures and the reports. Last, --help and bad options.
+# the pictures and the reports (the commit of the code among them). Last, --help and bad options.
 # usage: run_demo_test.sh DEMO CHECKER WORK_DIR
 set -uo pipefail
 demo="$1" checker="$2" work="$3"

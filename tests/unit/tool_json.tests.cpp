@@ -1,6 +1,6 @@
 // The tools' JSON files are written by a JSON library, so any string they carry reads back as it
 // was (the hand-written frame-cost writer once wrote quotes and newlines raw, and its files did
-// not parse).
+// not parse), and every results file records the commit of the code that wrote it.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "bench_output.h"
+#include "build_info.h"
 #include "json_file.h"
 #include "results.h"
 
@@ -44,6 +45,24 @@ Json readBack(const fs::path& file) {
   INFO((json ? std::string() : json.error().message));
   REQUIRE(json);
   return *json;
+}
+
+// The provenance record is this build's.
+void checkProvenance(const Json& file) {
+  REQUIRE(file.contains("provenance"));
+  const Json& p = file["provenance"];
+  CHECK(p["commit"] == sdfg::tools::buildCommit());
+  switch (sdfg::tools::buildTreeState()) {
+    case sdfg::tools::TreeState::clean:
+      CHECK(p["tree_dirty"] == false);
+      break;
+    case sdfg::tools::TreeState::dirty:
+      CHECK(p["tree_dirty"] == true);
+      break;
+    case sdfg::tools::TreeState::unknown:
+      CHECK(p["tree_dirty"].is_null());
+      break;
+  }
 }
 
 }  // namespace
@@ -87,6 +106,9 @@ TEST_CASE("The bench's JSON reads back every string as written", "[tools][json]"
     CHECK(row["tip_residual_mm"]["median"].is_null());
     CHECK(row["contacts_mean"].get<double>() == 0.0);
   }
+  SECTION("the commit of the code that wrote it") {
+    checkProvenance(json);
+  }
 }
 
 TEST_CASE("The frame-cost JSON reads back every string as written", "[tools][json]") {
@@ -128,6 +150,9 @@ TEST_CASE("The frame-cost JSON reads back every string as written", "[tools][jso
     CHECK(grab["added_max_ms"].get<double>() == 1.0);
     CHECK(json["meshes"][0]["grab_latency_frames"] == 3);
   }
+  SECTION("the commit of the code that wrote it") {
+    checkProvenance(json);
+  }
 }
 
 TEST_CASE("JSON files: bad bytes and bad files are handled, not fatal", "[tools][json]") {
@@ -155,5 +180,12 @@ TEST_CASE("JSON files: bad bytes and bad files are handled, not fatal", "[tools]
     const auto json = sdfg::tools::readJsonFile(dir / "absent.json");
     REQUIRE_FALSE(json);
     CHECK(json.error().message.find("absent.json") != std::string::npos);
+  }
+  SECTION("provenance reads back as written; a file without it has none") {
+    CHECK(sdfg::tools::describeProvenance(sdfg::tools::provenanceJson()) ==
+          sdfg::tools::describeBuild());
+    CHECK_FALSE(sdfg::tools::describeProvenance(Json()).has_value());
+    CHECK(sdfg::tools::describeProvenance(Json{{"commit", "abc"}, {"tree_dirty", true}}) ==
+          "abc (modified: tracked files differed from the commit)");
   }
 }

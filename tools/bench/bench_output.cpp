@@ -42,6 +42,7 @@ tools::Json resultsJson(const Options& o, const std::vector<Row>& rows) {
   out["resolution"] = o.resolution;
   out["seed"] = o.seed;
   out["exact_check"] = o.exactCheck;
+  out["provenance"] = tools::provenanceJson();
   Json& rowsOut = out["rows"] = Json::array();
   const std::initializer_list<std::pair<const char*, double>> medianP95 = {{"median", 0.5},
                                                                            {"p95", 0.95}};

@@ -11,8 +11,8 @@
 
 namespace sdfg::bench {
 
-// The run as the JSON that docs quote and --report reads: the settings, and one object per row
-// with its figures (null where there are none).
+// The run as the JSON that docs quote and --report reads: the settings, the provenance of the
+// build (json_file.h), and one object per row with its figures (null where there are none).
 tools::Json resultsJson(const Options& o, const std::vector<Row>& rows);
 // resultsJson() into `file`; false when it cannot be written.
 bool writeJson(const std::string& file, const Options& o, const std::vector<Row>& rows);

@@ -15,6 +15,7 @@
 #include "eval/evaluator.h"
 #include "hand/hand_model.h"
 
+#include "build_info.h"
 #include "report_detail.h"
 
 namespace fs = std::filesystem;
@@ -231,7 +232,23 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
     std::string a, b, c;
     if (loadavg >> a >> b >> c) load = a + ", " + b + ", " + c;
   }
+  // Which code made the figures: the commit each JSON recorded (a JSON from before the bench
+  // recorded it says so), and the code that wrote this page.
+  auto commitOf = [](const Json* provenance, const fs::path& file, const std::string& what) {
+    if (auto described = tools::describeProvenance(provenance ? *provenance : Json())) {
+      return *described;
+    }
+    return "not recorded: `" + file.string() + "` was written before " + what +
+           " recorded its commit";
+  };
   md << "| | |\n|---|---|\n"
+     << "| commit of the figures (bench run) | "
+     << commitOf(member(*json, "provenance"), request.resultsJson, "the bench") << " |\n";
+  if (scaling) {
+    md << "| commit of the SDF scaling figures | "
+       << commitOf(&scaling->provenance, request.scalingFrom, "the sweep") << " |\n";
+  }
+  md << "| commit of the report's writer | " << tools::describeBuild() << " |\n"
      << "| date | " << nowUtc() << " |\n"
      << "| CPU | " << (cpu.empty() ? "unknown" : cpu) << " |\n"
      << "| hardware threads (nproc) | " << std::thread::hardware_concurrency() << " |\n"

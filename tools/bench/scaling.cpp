@@ -119,6 +119,7 @@ Result<ScalingResults> runScaling(const ScalingOptions& options) {
   ScalingBuilders made = makeScalingBuilders(options.backends, options.threads);
   ScalingResults results;
   results.repeats = options.repeats;
+  results.provenance = tools::provenanceJson();
   results.unavailable = made.unavailable;
   for (const std::string& u : made.unavailable) {
     std::fprintf(stderr, "autograsp-bench: scaling: %s; its column is left out\n", u.c_str());
@@ -273,6 +274,7 @@ std::optional<Error> writeScalingJson(const fs::path& file, const ScalingResults
   out["devices"] = r.devices;
   out["unavailable"] = r.unavailable;
   out["repeats"] = r.repeats;
+  if (!r.provenance.is_null()) out["provenance"] = r.provenance;
   out["by_triangles"] = points(r.byTriangles);
   out["by_resolution"] = points(r.byResolution);
   return tools::writeJsonFile(file, out);
@@ -296,6 +298,7 @@ Result<ScalingResults> readScalingJson(const fs::path& file) {
   r.devices.resize(r.builders.size());
   const double repeats = numberOf(member(json, "repeats"));
   r.repeats = std::isfinite(repeats) ? int(repeats) : 0;
+  if (const Json* p = member(json, "provenance")) r.provenance = *p;
   auto number = [](const Json& object, const char* key, const std::string& sub = {}) {
     const Json* v = member(object, key);
     if (v && !sub.empty()) v = member(*v, sub);

@@ -6,6 +6,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "build_info.h"
+
 namespace sdfg::tools {
 
 Json jsonNumber(double v) {
@@ -15,6 +17,33 @@ Json jsonNumber(double v) {
   char text[32];
   std::snprintf(text, sizeof text, "%.6g", v);
   return std::strtod(text, nullptr);
+}
+
+Json provenanceJson() {
+  Json out;
+  out["commit"] = buildCommit();
+  switch (buildTreeState()) {
+    case TreeState::clean:
+      out["tree_dirty"] = false;
+      break;
+    case TreeState::dirty:
+      out["tree_dirty"] = true;
+      break;
+    case TreeState::unknown:
+      out["tree_dirty"] = nullptr;
+      break;
+  }
+  return out;
+}
+
+std::optional<std::string> describeProvenance(const Json& record) {
+  if (!record.is_object()) return std::nullopt;
+  const auto commit = record.find("commit");
+  if (commit == record.end() || !commit->is_string()) return std::nullopt;
+  const auto dirty = record.find("tree_dirty");
+  return describeCommit(commit->get<std::string>(), dirty != record.end() && dirty->is_boolean()
+                                                        ? std::optional<bool>(dirty->get<bool>())
+                                                        : std::nullopt);
 }
 
 std::optional<Error> writeJsonFile(const std::filesystem::path& file, const Json& value) {

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -18,6 +19,13 @@ using Json = nlohmann::ordered_json;
 // A measured number as the tools write it: rounded to 6 significant digits (no figure of theirs
 // carries more), null when not finite.
 Json jsonNumber(double v);
+
+// The build that writes a file, for its "provenance" member: {"commit": "<full hash>" or
+// "unknown", "tree_dirty": true / false, or null when not known} (build_info.h).
+Json provenanceJson();
+// describeCommit() of a "provenance" member as provenanceJson() wrote it; nothing when `record`
+// is not one (null: the file was written before the tools recorded it).
+std::optional<std::string> describeProvenance(const Json& record);
 
 // Writes `value` with a two-space indent and a final newline. Invalid UTF-8 in a string (a file
 // name in another encoding) is written as U+FFFD instead of failing. Errors: io_error naming the

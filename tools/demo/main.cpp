@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "build_info.h"
 #include "cli_options.h"
 #include "demo_config.h"
 #include "eval/solver_physics.h"
@@ -247,6 +248,7 @@ int main(int argc, char** argv) {
   ReportInfo info;
   info.width = int(opt.width);
   info.environment = prepareEnvironment();
+  info.commit = tools::describeBuild();
   XrApp app;
   std::string error;
   if (!app.init(error)) {

@@ -38,6 +38,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "build_info.h"
 #include "cli_options.h"
 #include "frame_cost_config.h"
 #include "hand/hand_model.h"
@@ -548,8 +549,8 @@ int main(int argc, char** argv) {
 
   std::printf(
       "\nTime the layer adds to the app's OpenXR calls per frame (ms; layer on minus the "
-      "layer-off median of the phase), 90 Hz pacing, %d frames per phase\n\n",
-      phaseFrames);
+      "layer-off median of the phase), 90 Hz pacing, %d frames per phase; code at commit %s\n\n",
+      phaseFrames, sdfg::tools::describeBuild().c_str());
   std::printf("| object | triangles | create call | set-up | grab latency (frames) |");
   for (const char* p : kPhases) std::printf(" %s p50 / p99 / max |", p);
   std::printf("\n|---|---:|---:|---:|---:|");

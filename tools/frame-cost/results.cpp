@@ -30,6 +30,7 @@ tools::Json resultsJson(const std::vector<MeshResult>& results, int phaseFrames,
   out["frames_per_phase"] = phaseFrames;
   out["frame_period_ms"] = jsonNumber(framePeriodMs);
   out["hardware_threads"] = std::thread::hardware_concurrency();
+  out["provenance"] = tools::provenanceJson();
   out["skipped"] = skipped;
   Json& meshes = out["meshes"] = Json::array();
   for (const MeshResult& r : results) {

@@ -54,8 +54,9 @@ struct MeshResult {
   std::array<Percentiles, kPhaseCount> offStats;  // the layer-off run's own frame totals
 };
 
-// The results as JSON: the settings, the objects skipped (not found or unreadable), and per object
-// its calls, set-up, grab latency and, per phase, the time added per frame.
+// The results as JSON: the settings, the provenance of the build (json_file.h), the objects
+// skipped (not found or unreadable), and per object its calls, set-up, grab latency and, per
+// phase, the time added per frame.
 tools::Json resultsJson(const std::vector<MeshResult>& results, int phaseFrames,
                         double framePeriodMs, const std::vector<std::string>& skipped);
 

@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "build_info.h"
 #include "cli_options.h"
 #include "mesh/mesh_distance.h"
 #include "sdf/sdf_grid.h"
@@ -128,6 +129,7 @@ int main(int argc, char** argv) {
   const std::vector<glm::vec3> points = tools::frameSamplePoints();
   std::printf("# autograsp-sdf-scaling: grab-box SDF build + 50 samples, median of %d runs\n",
               runs);
+  std::printf("# code at commit %s\n", tools::describeBuild().c_str());
   std::printf("# vulkan device: %s; cpu: %s, far-field band %g m\n",
               haveVulkan ? builders[1]->device().c_str() : "none", builders[0]->device().c_str(),
               double(builderOptions.cpuExactBand));

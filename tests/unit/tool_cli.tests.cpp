@@ -66,8 +66,8 @@ TEST_CASE("A seed takes the whole unsigned 64-bit range and nothing negative", "
     CHECK_FALSE(parse(app, {"--seed", "18446744073709551615"}));
     CHECK(seed == UINT64_MAX);
   }
-  SECTION("negative (CLI11 alone would wrap it), too large, not a number") {
-    for (const char* bad : {"-1", "18446744073709551616", "x"}) {
+  SECTION("negative (CLI11 alone would wrap it), too large, not a number; the seed unchanged") {
+    for (const char* bad : {"-1", "18446744073709551616", "x", "12x"}) {
       CAPTURE(bad);
       CLI::App fresh;
       uint64_t v = 1;

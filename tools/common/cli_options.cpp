@@ -47,7 +47,9 @@ CLI::Option* addInteger(CLI::App& app, const std::string& name, long long lo, lo
 
 CLI::Option* addUnsigned64(CLI::App& app, const std::string& name, std::uint64_t& out) {
   return single(app.add_option_function<std::string>(name, [name, &out](const std::string& v) {
-    if (!decimal(v, out)) throw valueError(name, v, "a non-negative integer");
+    std::uint64_t n = 0;
+    if (!decimal(v, n)) throw valueError(name, v, "a non-negative integer");
+    out = n;
   }));
 }
 

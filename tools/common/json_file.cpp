@@ -1,7 +1,7 @@
 #include "json_file.h"
 
+#include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -12,10 +12,14 @@ namespace sdfg::tools {
 
 Json jsonNumber(double v) {
   if (!std::isfinite(v)) return nullptr;
-  // Through the decimal text: nlohmann writes the shortest form that reads back to the same
-  // double, so 0.1f is written as 0.1, not 0.10000000149011612.
+  return v;
+}
+
+Json jsonNumber(float v) {
+  if (!std::isfinite(v)) return nullptr;
   char text[32];
-  std::snprintf(text, sizeof text, "%.6g", v);
+  const auto [end, ec] = std::to_chars(text, text + sizeof text - 1, v);  // shortest form
+  *end = '\0';
   return std::strtod(text, nullptr);
 }
 

@@ -16,9 +16,13 @@ namespace sdfg::tools {
 
 using Json = nlohmann::ordered_json;
 
-// A measured number as the tools write it: rounded to 6 significant digits (no figure of theirs
-// carries more), null when not finite.
+// A number as the tools write it, null when not finite. A double is kept exactly (nlohmann writes
+// the shortest text that reads back to the same double), so a report made from the JSON shows
+// the same figures as the run's own (rounding to 6 digits first and to 3 in a table could differ
+// in the last digit). A float is written as the shortest text that reads back to the same float:
+// 0.1f as 0.1, not as its double 0.10000000149011612.
 Json jsonNumber(double v);
+Json jsonNumber(float v);
 
 // The build that writes a file, for its "provenance" member: {"commit": "<full hash>" or
 // "unknown", "tree_dirty": true / false, or null when not known} (build_info.h).

@@ -16,6 +16,8 @@ packages=(
   libassimp-dev libcgal-dev libgmp-dev libmpfr-dev
   # images and plots for the demo and the benchmark report
   libpng-dev gnuplot-nox
+  # the tools' JSON files and command lines (header-only; tools/ only, never the layer)
+  nlohmann-json3-dev libcli11-dev
   # the OpenXR CTS, built from ../shared/cts by `ctest -L cts` (tests/cts/build_cts.sh)
   python3 python3-jinja2 libx11-xcb-dev libxrandr-dev libxxf86vm-dev mesa-common-dev
   libxcb-glx0-dev

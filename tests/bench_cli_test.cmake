@@ -150,6 +150,14 @@ if(rows LESS 3)
   message(FATAL_ERROR "only ${rows} rows for three embedded objects")
 endif()
 check_rows("${json}" 5)
+# The commit of the code that wrote it: a full hash (this is a checkout) or "unknown" (a tarball).
+string(JSON commit ERROR_VARIABLE err GET "${json}" provenance commit)
+string(LENGTH "${commit}" length)
+string(JSON dirty_type ERROR_VARIABLE err2 TYPE "${json}" provenance tree_dirty)
+if(err OR err2 OR NOT (commit MATCHES "^[0-9a-f]+$" AND length EQUAL 40)
+    AND NOT commit STREQUAL "unknown" OR NOT dirty_type MATCHES "^(BOOLEAN|NULL)$")
+  message(FATAL_ERROR "provenance: commit \"${commit}\" ${err}, tree_dirty ${dirty_type} ${err2}")
+endif()
 if(NOT out MATCHES "Solve time per grasp" OR NOT out MATCHES "Quality")
   message(FATAL_ERROR "tables missing from the output:\n${out}")
 endif()
@@ -232,9 +240,11 @@ if(NOT rows EQUAL 1 OR NOT mesh STREQUAL "cube")
 endif()
 check_row("${json}" 0 3)
 
-# 3. Bad option values are usage errors.
+# 3. Bad option values are usage errors: out of range, not decimal (010 and 0x10 are not read as
+# octal or hexadecimal), a negative seed, two values after a single --mesh.
 foreach(args "--placements;abc" "--methods;nope" "--resolution;1" "--da;0" "--bogus"
-    "--sdf-backend;gpu" "--sdf-backend;," "--exact-check;maybe" "--exact-check")
+    "--sdf-backend;gpu" "--sdf-backend;," "--exact-check;maybe" "--exact-check"
+    "--placements;0x10" "--seed;-1" "--da;nan" "--mesh;a.obj;b.obj" "--json;")
   execute_process(COMMAND "${BENCH}" ${args} RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
   if(NOT rc EQUAL 2 OR NOT err MATCHES "usage")
     message(FATAL_ERROR "\"${args}\" exited ${rc}, expected 2 with usage:\n${err}")

@@ -1,7 +1,8 @@
 # Drives `autograsp-bench --report` like a user: a short run (embedded objects, 5 placements, the
-# quick scaling sweep) writes benchmarks.md with the command, the speed, quality and scaling
-# tables holding finite numbers, and non-empty PNGs for every image it links (when gnuplot is
-# installed; without it the Markdown says so).
+# quick scaling sweep) writes benchmarks.md with the command, the commit of the code, the speed,
+# quality and scaling tables holding finite numbers, and non-empty PNGs for every image it links
+# (when gnuplot is installed; without it the Markdown says so). --report-from quotes the commit
+# its JSON recorded, and says so when the JSON has none.
 # Usage: cmake -DBENCH=<autograsp-bench> -DWORK=<scratch dir> -P bench_report_test.cmake
 cmake_minimum_required(VERSION 3.25)
 if(NOT BENCH OR NOT WORK)
@@ -24,10 +25,23 @@ file(READ "${dir}/benchmarks.md" md)
 
 foreach(needle "--report" "## Speed" "## Quality" "SDF build time against triangle count"
     "SDF build time against grid resolution" "| CPU |" "hardware threads"
-    "| run settings | placements 5, " "exact_check on")
+    "| run settings | placements 5, " "exact_check on" "| commit of the figures (bench run) | "
+    "| commit of the SDF scaling figures | " "| commit of the report's writer | ")
   string(FIND "${md}" "${needle}" at)
   if(at EQUAL -1)
     message(FATAL_ERROR "benchmarks.md lacks \"${needle}\":\n${md}")
+  endif()
+endforeach()
+# The commit of the code, the same in all three rows (one run made the figures and the report).
+set(described "([0-9a-f]+ \\((clean|modified)[^|]*|unknown [^|]*)")
+if(NOT md MATCHES "\n\\| commit of the figures \\(bench run\\) \\| ${described} \\|\n")
+  message(FATAL_ERROR "benchmarks.md does not name the commit of its figures:\n${md}")
+endif()
+set(commit "${CMAKE_MATCH_1}")
+foreach(row "commit of the SDF scaling figures" "commit of the report's writer")
+  string(FIND "${md}" "| ${row} | ${commit} |" at)
+  if(at EQUAL -1)
+    message(FATAL_ERROR "benchmarks.md: \"${row}\" is not ${commit}:\n${md}")
   endif()
 endforeach()
 string(TOLOWER "${md}" lower)
@@ -117,6 +131,28 @@ string(REGEX MATCH "### SDF build time against triangle count.*### SDF build tim
 string(REGEX MATCH "### SDF build time against triangle count.*### SDF build time against grid resolution[^#]*" sweep2 "${md2}")
 if(sweep1 STREQUAL "" OR NOT sweep1 STREQUAL sweep2)
   message(FATAL_ERROR "the sweep differs after --scaling-from:\n${sweep1}\n---\n${sweep2}")
+endif()
+# ... and both JSON files carry the commit the report quoted.
+string(FIND "${md2}" "| commit of the figures (bench run) | ${commit} |" at)
+string(FIND "${md2}" "| commit of the SDF scaling figures | ${commit} |" at2)
+if(at EQUAL -1 OR at2 EQUAL -1)
+  message(FATAL_ERROR "--report-from does not quote the commits of its JSON (${commit}):\n${md2}")
+endif()
+# A JSON written before the bench recorded its commit: the report says so.
+file(READ ${results} json)
+string(JSON json REMOVE "${json}" provenance)
+file(WRITE "${WORK}/old.json" "${json}")
+file(READ "${WORK}/scaling.json" json)
+string(JSON json REMOVE "${json}" provenance)
+file(WRITE "${WORK}/old-scaling.json" "${json}")
+execute_process(COMMAND "${BENCH}" --report-from "${WORK}/old.json" --report "${again}"
+                --scaling-from "${WORK}/old-scaling.json" RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                ERROR_VARIABLE err)
+file(READ "${again}/benchmarks.md" md3)
+string(FIND "${md3}" "| commit of the figures (bench run) | not recorded: `${WORK}/old.json` was written before the bench recorded its commit |" at)
+string(FIND "${md3}" "| commit of the SDF scaling figures | not recorded: `${WORK}/old-scaling.json` was written before the sweep recorded its commit |" at2)
+if(NOT rc EQUAL 0 OR at EQUAL -1 OR at2 EQUAL -1)
+  message(FATAL_ERROR "a JSON without a commit: exit ${rc}, report:\n${md3}\n${err}")
 endif()
 execute_process(COMMAND "${BENCH}" --report-from "${WORK}/missing.json" --report "${again}"
                 RESULT_VARIABLE rc ERROR_VARIABLE err)

@@ -1,6 +1,7 @@
 # Smoke test of autograsp-frame-cost (label layer): one embedded object, a few frames per phase,
 # through the real loader, the mock runtime and the layer. Checks the run succeeds and its JSON
-# has every key docs/benchmarks.md quotes; timings are the benchmark's business, not a test's.
+# has every key docs/benchmarks.md quotes and the commit of the code, and that a bad option value
+# is a usage error; timings are the benchmark's business, not a test's.
 # Inputs: -DTOOL=<autograsp-frame-cost> -DWORK=<scratch folder>
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
@@ -17,12 +18,20 @@ string(JSON n LENGTH "${json}" meshes)
 if(NOT n EQUAL 1)
   message(FATAL_ERROR "expected 1 mesh in the JSON, got ${n}")
 endif()
-foreach(key frames_per_phase frame_period_ms hardware_threads skipped)
+foreach(key frames_per_phase frame_period_ms hardware_threads skipped provenance)
   string(JSON v ERROR_VARIABLE e GET "${json}" ${key})
   if(e)
     message(FATAL_ERROR "JSON lacks ${key}: ${e}")
   endif()
 endforeach()
+# The commit of the code that wrote it: a full hash (this is a checkout) or "unknown" (a tarball).
+string(JSON commit GET "${json}" provenance commit)
+string(LENGTH "${commit}" length)
+string(JSON dirty_type TYPE "${json}" provenance tree_dirty)
+if(NOT (commit MATCHES "^[0-9a-f]+$" AND length EQUAL 40) AND NOT commit STREQUAL "unknown"
+    OR NOT dirty_type MATCHES "^(BOOLEAN|NULL)$")
+  message(FATAL_ERROR "provenance: commit \"${commit}\", tree_dirty ${dirty_type}")
+endif()
 string(JSON ok GET "${json}" meshes 0 ok)
 if(NOT ok)
   message(FATAL_ERROR "the mug run failed: ${json}")
@@ -53,4 +62,9 @@ foreach(call xrWaitFrame xrBeginFrame xrSyncActions xrLocateHandJointsEXT xrEndF
     message(FATAL_ERROR "JSON lacks the timing of ${call}: ${e}")
   endif()
 endforeach()
+# A bad option value is a usage error (exit 2) naming the value.
+execute_process(COMMAND ${TOOL} --frames 5x RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "--frames: \"5x\" is not an integer" OR NOT err MATCHES "usage")
+  message(FATAL_ERROR "--frames 5x: exit ${rc}, expected 2 with usage:\n${err}")
+endif()
 message(STATUS "frame-cost JSON complete (mug, grab latency ${latency} frames)")

@@ -2,7 +2,7 @@
 # The demo test: autograsp-demo on a small setting (embedded objects, 512 px panels) plus a broken
 # mesh file. The broken file must get a clear message naming it, the run must go on and grasp
 # every embedded object, and exit 1 (something was skipped); then autograsp-demo-check checks
-# the pictures and the reports.
+# the pictures and the reports (the commit of the code among them). Last, --help and bad options.
 # usage: run_demo_test.sh DEMO CHECKER WORK_DIR
 set -uo pipefail
 demo="$1" checker="$2" work="$3"
@@ -30,4 +30,20 @@ if ! grep -q "broken-mesh.obj" "$work/out/report.md"; then
   echo "FAIL: report.md does not list the skipped mesh"; fail=1
 fi
 "$checker" "$work/out" 512 mug torus thin-plate || fail=1
+# Options: --help prints the usage (exit 0); a value out of range is named (exit 2), and so is an
+# unknown option; neither starts the demo.
+if ! "$demo" --help | grep -q "^usage: autograsp-demo"; then
+  echo "FAIL: --help does not print the usage"; fail=1
+fi
+for args in "--width 100|--width: \"100\" is not 256..2048" "--resolution 0x10|--resolution: \"0x10\" is not 2..128" \
+    "--bogus|not expected: --bogus"; do
+  message="${args#*|}"
+  "$demo" ${args%%|*} --out "$work/not-run" >/dev/null 2>"$work/usage.txt"
+  rc=$?
+  if [ "$rc" -ne 2 ] || ! grep -qF -- "$message" "$work/usage.txt" || [ -e "$work/not-run" ]; then
+    echo "FAIL: '${args%%|*}' exited $rc, expected 2 with '$message':"; cat "$work/usage.txt"; fail=1
+  else
+    echo "ok:   ${args%%|*}: $(cat "$work/usage.txt")"
+  fi
+done
 exit $fail

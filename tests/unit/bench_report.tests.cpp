@@ -1,5 +1,6 @@
 // The bench report renders what the JSON holds: a metric it has never heard of becomes a column
-// and a figure; a broken JSON is an error that names the file, not a crash.
+// and a figure, the commit the JSON recorded goes into the header (or that it recorded none); a
+// broken JSON is an error that names the file, not a crash.
 #include <catch2/catch.hpp>
 
 #include <filesystem>
@@ -7,6 +8,7 @@
 #include <sstream>
 #include <string>
 
+#include "build_info.h"
 #include "report.h"
 
 namespace fs = std::filesystem;
@@ -54,9 +56,15 @@ TEST_CASE("The report renders every JSON metric, known or not", "[bench][report]
   const std::string md = readAll(request.dir / "benchmarks.md");
   REQUIRE_FALSE(md.empty());
 
-  SECTION("the command, the settings and the speed table") {
+  SECTION("the command, the commits, the settings and the speed table") {
     CHECK(md.find("autograsp-bench --report out") != std::string::npos);
     CHECK(md.find("| run settings | placements 2, seed 7 |") != std::string::npos);
+    // A JSON from before the bench recorded its commit says so; the writer's is this build's.
+    CHECK(md.find("| commit of the figures (bench run) | not recorded: `" + json.string() +
+                  "` was written before the bench recorded its commit |") != std::string::npos);
+    CHECK(md.find("| commit of the report's writer | " + sdfg::tools::describeBuild() + " |") !=
+          std::string::npos);
+    CHECK(md.find("commit of the SDF scaling figures") == std::string::npos);  // no sweep
     CHECK(md.find("| paper | 2.25 |") != std::string::npos);
     CHECK(md.find("| ours | 40 |") != std::string::npos);
     CHECK(md.find("| CPU SDF build (ms) | 1.5 |") != std::string::npos);
@@ -91,7 +99,8 @@ TEST_CASE("The report renders every JSON metric, known or not", "[bench][report]
 TEST_CASE("Rows of one method on two SDF backends get a backend column", "[bench][report]") {
   const fs::path dir = scratch("backends");
   const fs::path json = dir / "in.json";
-  std::ofstream(json) << R"({"placements": 2, "rows": [
+  std::ofstream(json) << R"({"placements": 2,
+    "provenance": {"commit": "0123abc", "tree_dirty": true}, "rows": [
     {"mesh": "cube", "triangles": 12, "method": "paper", "sdf_backend": "cpu", "grasps": 2,
      "sdf_build_ms": {"median": 1.5}, "solve_us": {"median": 2.25}, "pass_through": 3},
     {"mesh": "cube", "triangles": 12, "method": "paper", "sdf_backend": "vulkan", "grasps": 2,
@@ -106,6 +115,11 @@ TEST_CASE("Rows of one method on two SDF backends get a backend column", "[bench
   const std::string md = readAll(request.dir / "benchmarks.md");
   REQUIRE_FALSE(md.empty());
 
+  SECTION("the commit the JSON recorded; its provenance is no setting") {
+    CHECK(md.find("| commit of the figures (bench run) | 0123abc (modified: tracked files "
+                  "differed from the commit) |") != std::string::npos);
+    CHECK(md.find("| run settings | placements 2 |") != std::string::npos);
+  }
   SECTION("the speed table: one row per method and backend, one build row per backend") {
     CHECK(md.find("| method | SDF backend | cube |") != std::string::npos);
     CHECK(md.find("| paper | cpu | 2.25 |") != std::string::npos);

@@ -1,10 +1,9 @@
 #include "bench_options.h"
 
 #include <algorithm>
-#include <cstdlib>
-#include <sstream>
 #include <string>
 
+#include "cli_options.h"
 #include "eval/strategies.h"
 
 namespace sdfg::bench {
@@ -52,161 +51,45 @@ const char* const kUsage =
     "exit codes: 0 done; 1 a mesh, solve or output failed; 2 bad option; 3 done, but a\n"
     "requested SDF backend (vulkan) had no device: its rows and columns are left out\n";
 
-namespace {
-
-bool parseInt(const std::string& s, long long lo, long long hi, long long& out) {
-  if (s.empty()) return false;
-  char* end = nullptr;
-  errno = 0;
-  const long long v = std::strtoll(s.c_str(), &end, 10);
-  if (errno != 0 || *end != '\0' || v < lo || v > hi) return false;
-  out = v;
-  return true;
-}
-
-}  // namespace
-
 std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& help) {
+  namespace cli = tools::cli;
   const std::vector<std::string> known = allSolverNames();
-  for (int i = 1; i < argc; ++i) {
-    std::string arg = argv[i];
-    std::string value;
-    bool hasValue = false;
-    if (const size_t eq = arg.find('='); arg.rfind("--", 0) == 0 && eq != std::string::npos) {
-      value = arg.substr(eq + 1);
-      arg = arg.substr(0, eq);
-      hasValue = true;
-    }
-    auto next = [&]() -> std::optional<std::string> {
-      if (hasValue) return value;
-      if (i + 1 >= argc) return std::nullopt;
-      return std::string(argv[++i]);
-    };
-    auto needValue = [&](std::string& out) -> std::optional<UsageError> {
-      auto v = next();
-      if (!v) return UsageError{arg + " needs a value"};
-      out = *v;
-      return std::nullopt;
-    };
-    // A value that must not be empty (a file or folder).
-    auto needName = [&](std::string& out, const char* what) -> std::optional<UsageError> {
-      if (auto e = needValue(out)) return e;
-      if (out.empty()) return UsageError{arg + ": empty " + what};
-      return std::nullopt;
-    };
-    // A comma-separated list of names from `names`, each kept once, in order.
-    auto needList = [&](const std::vector<std::string>& names, const std::string& what,
-                        std::vector<std::string>& out) -> std::optional<UsageError> {
-      std::string text;
-      if (auto e = needValue(text)) return e;
-      out.clear();
-      std::stringstream ss(text);
-      std::string item;
-      while (std::getline(ss, item, ',')) {
-        if (item.empty()) continue;
-        if (std::find(names.begin(), names.end(), item) == names.end()) {
-          std::string list;
-          for (const auto& k : names) list += (list.empty() ? "" : ", ") + k;
-          return UsageError{arg + ": unknown " + what + " \"" + item + "\"; known: " + list};
-        }
-        if (std::find(out.begin(), out.end(), item) == out.end()) out.push_back(item);
-      }
-      if (out.empty()) return UsageError{arg + ": no " + what + " given"};
-      return std::nullopt;
-    };
-    std::string v;
-    long long n = 0;
-    if (arg == "--help" || arg == "-h") {
-      help = true;
-    } else if (arg == "--embedded") {
-      o.embedded = true;
-    } else if (arg == "--embedded-only") {
-      o.embeddedOnly = true;
-    } else if (arg == "--thin-plate-set") {
-      o.thinPlateSet = true;
-    } else if (arg == "--approaching") {
-      o.approaching = true;
-    } else if (arg == "--mesh") {
-      if (auto e = needValue(v)) return e;
-      o.meshes.push_back(v);
-    } else if (arg == "--placements") {
-      if (auto e = needValue(v)) return e;
-      if (!parseInt(v, 1, 1000000, n))
-        return UsageError{"--placements: \"" + v + "\" is not 1..1000000"};
-      o.placements = int(n);
-    } else if (arg == "--seed") {
-      if (auto e = needValue(v)) return e;
-      char* end = nullptr;
-      errno = 0;
-      const unsigned long long s = std::strtoull(v.c_str(), &end, 10);
-      if (v.empty() || v[0] == '-' || errno != 0 || *end != '\0') {
-        return UsageError{"--seed: \"" + v + "\" is not a non-negative integer"};
-      }
-      o.seed = s;
-    } else if (arg == "--methods") {
-      if (auto e = needList(known, "method", o.methods)) return e;
-    } else if (arg == "--da") {
-      if (auto e = needValue(v)) return e;
-      char* end = nullptr;
-      const float x = std::strtof(v.c_str(), &end);
-      if (v.empty() || *end != '\0' || !std::isfinite(x) || !(x > 0.0f) || x > 1.0f) {
-        return UsageError{"--da: \"" + v + "\" is not a number in (0, 1]"};
-      }
-      o.da = x;
-    } else if (arg == "--resolution") {
-      if (auto e = needValue(v)) return e;
-      if (!parseInt(v, kMinGridResolution, kMaxGridResolution, n)) {
-        return UsageError{"--resolution: \"" + v + "\" is not 2..128"};
-      }
-      o.resolution = int(n);
-    } else if (arg == "--exact-check") {
-      if (auto e = needValue(v)) return e;
-      if (v != "on" && v != "off")
-        return UsageError{"--exact-check: \"" + v + "\" is not on or off"};
-      o.exactCheck = v == "on";
-    } else if (arg == "--clear-hand") {
-      if (auto e = needValue(v)) return e;
-      if (v != "on" && v != "off")
-        return UsageError{"--clear-hand: \"" + v + "\" is not on or off"};
-      o.clearHand = v == "on";
-    } else if (arg == "--threads") {
-      if (auto e = needValue(v)) return e;
-      if (!parseInt(v, 0, 1024, n)) return UsageError{"--threads: \"" + v + "\" is not 0..1024"};
-      o.threads = unsigned(n);
-    } else if (arg == "--sdf-far-band") {
-      if (auto e = needValue(v)) return e;
-      char* end = nullptr;
-      const float x = std::strtof(v.c_str(), &end);
-      if (v.empty() || *end != '\0' || !std::isfinite(x) || !(x >= 0.0f)) {
-        return UsageError{"--sdf-far-band: \"" + v + "\" is not a distance >= 0 in metres"};
-      }
-      o.sdfFarBand = x;
-    } else if (arg == "--sdf-backend") {
-      if (auto e =
-              needList({tools::kCpuBackend, tools::kVulkanBackend}, "backend", o.sdfBackends)) {
-        return e;
-      }
-      o.sdfBackendsGiven = true;
-    } else if (arg == "--json") {
-      if (auto e = needName(o.json, "file name")) return e;
-    } else if (arg == "--report") {
-      if (auto e = needName(o.report, "folder name")) return e;
-      o.scaling = true;
-    } else if (arg == "--scaling-json") {
-      if (auto e = needName(o.scalingJson, "file name")) return e;
-      o.scaling = true;
-    } else if (arg == "--scaling-from") {
-      if (auto e = needName(o.scalingFrom, "file name")) return e;
-      o.scaling = true;
-    } else if (arg == "--report-from") {
-      if (auto e = needName(o.reportFrom, "file name")) return e;
-    } else if (arg == "--scaling" || arg == "--scaling-quick") {
-      o.scaling = true;
-      o.scalingQuick = o.scalingQuick || arg == "--scaling-quick";
-    } else {
-      return UsageError{"unknown option \"" + std::string(argv[i]) + "\""};
-    }
-  }
+  CLI::App app{"", "autograsp-bench"};
+  cli::addHelpFlag(app, help);
+  app.add_flag("--embedded", o.embedded);
+  app.add_flag("--embedded-only", o.embeddedOnly);
+  app.add_flag("--thin-plate-set", o.thinPlateSet);
+  app.add_flag("--approaching", o.approaching);
+  cli::addRepeatable(app, "--mesh", o.meshes);
+  cli::addInteger(app, "--placements", o.placements, 1, 1000000);
+  cli::addUnsigned64(app, "--seed", o.seed);
+  cli::addList(app, "--methods", known, "method", o.methods);
+  cli::addNumber(
+      app, "--da", o.da, [](float x) { return x > 0.0f && x <= 1.0f; }, "a number in (0, 1]");
+  cli::addInteger(app, "--resolution", o.resolution, kMinGridResolution, kMaxGridResolution);
+  cli::addOnOff(app, "--exact-check", o.exactCheck);
+  cli::addOnOff(app, "--clear-hand", o.clearHand);
+  cli::addInteger(app, "--threads", o.threads, 0, 1024);
+  cli::addNumber(
+      app, "--sdf-far-band", o.sdfFarBand, [](float x) { return x >= 0.0f; },
+      "a distance >= 0 in metres");
+  const CLI::Option* backends = cli::addList(
+      app, "--sdf-backend", {tools::kCpuBackend, tools::kVulkanBackend}, "backend", o.sdfBackends);
+  cli::addName(app, "--json", o.json, "file name");
+  cli::addName(app, "--report", o.report, "folder name");
+  cli::addName(app, "--scaling-json", o.scalingJson, "file name");
+  cli::addName(app, "--scaling-from", o.scalingFrom, "file name");
+  cli::addName(app, "--report-from", o.reportFrom, "file name");
+  bool scaling = false, scalingQuick = false;
+  app.add_flag("--scaling", scaling);
+  app.add_flag("--scaling-quick", scalingQuick);
+  if (auto error = cli::parse(app, argc, argv)) return UsageError{*error};
+
+  o.sdfBackendsGiven = backends->count() > 0;
+  // --report, --scaling-json and --scaling-from imply --scaling.
+  o.scalingQuick = scalingQuick;
+  o.scaling = scaling || scalingQuick || !o.report.empty() || !o.scalingJson.empty() ||
+              !o.scalingFrom.empty();
   if (o.methods.empty()) o.methods = known;
   if (o.thinPlateSet) {
     if (o.da != 0.1f) return UsageError{"--thin-plate-set: the set is defined at --da 0.1"};

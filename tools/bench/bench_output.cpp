@@ -4,23 +4,17 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
+#include <initializer_list>
 #include <map>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
-#include "report.h"
+#include "json_file.h"
 
 namespace sdfg::bench {
 namespace {
-
-// Per-finger counts, thumb to little.
-std::string jsonCounts(const std::array<long long, kFingerCount>& counts) {
-  std::string out = "[";
-  for (int f = 0; f < kFingerCount; ++f) out += (f ? ", " : "") + std::to_string(counts[f]);
-  return out + "]";
-}
 
 std::string fmt(double v, const char* format = "%.3g") {
   if (!std::isfinite(v)) return "-";
@@ -29,49 +23,60 @@ std::string fmt(double v, const char* format = "%.3g") {
   return buf;
 }
 
+// {"median": .., "p95": ..} and the like: the given percentiles of `v`, by name.
+tools::Json percentiles(const std::vector<double>& v,
+                        std::initializer_list<std::pair<const char*, double>> which) {
+  tools::Json out = tools::Json::object();
+  for (const auto& [name, q] : which) out[name] = tools::jsonNumber(percentile(v, q));
+  return out;
+}
+
 }  // namespace
 
-bool writeJson(const std::string& file, const Options& o, const std::vector<Row>& rows) {
-  std::ofstream out(file);
-  if (!out) return false;
-  out << "{\n  \"placements\": " << o.placements << ",\n  \"da\": " << jsonNumber(o.da)
-      << ",\n  \"resolution\": " << o.resolution << ",\n  \"seed\": " << o.seed
-      << ",\n  \"exact_check\": " << (o.exactCheck ? "true" : "false") << ",\n  \"rows\": [";
-  for (size_t i = 0; i < rows.size(); ++i) {
-    const Row& r = rows[i];
-    const double nan = std::nan("");
-    const double buildMedian = r.usesField ? percentile(r.sdfBuildMs, 0.5) : nan;
-    const double buildP95 = r.usesField ? percentile(r.sdfBuildMs, 0.95) : nan;
-    out << (i ? ",\n" : "\n") << "    {\"mesh\": " << jsonString(r.mesh)
-        << ", \"triangles\": " << r.triangles << ", \"method\": " << jsonString(r.method)
-        << ", \"sdf_backend\": " << jsonString(r.backend) << ", \"grasps\": " << r.grasps
-        << ",\n     \"sdf_build_ms\": {\"median\": " << jsonNumber(buildMedian)
-        << ", \"p95\": " << jsonNumber(buildP95) << "}"
-        << ", \"solve_us\": {\"median\": " << jsonNumber(percentile(r.solveUs, 0.5))
-        << ", \"p95\": " << jsonNumber(percentile(r.solveUs, 0.95)) << "}";
+tools::Json resultsJson(const Options& o, const std::vector<Row>& rows) {
+  using tools::Json;
+  using tools::jsonNumber;
+  Json out;
+  out["placements"] = o.placements;
+  out["da"] = jsonNumber(o.da);
+  out["resolution"] = o.resolution;
+  out["seed"] = o.seed;
+  out["exact_check"] = o.exactCheck;
+  out["provenance"] = tools::provenanceJson();
+  Json& rowsOut = out["rows"] = Json::array();
+  const std::initializer_list<std::pair<const char*, double>> medianP95 = {{"median", 0.5},
+                                                                           {"p95", 0.95}};
+  for (const Row& r : rows) {
+    Json row;
+    row["mesh"] = r.mesh;
+    row["triangles"] = r.triangles;
+    row["method"] = r.method;
+    row["sdf_backend"] = r.backend;
+    row["grasps"] = r.grasps;
+    // Physics methods build no field: their build times are null.
+    row["sdf_build_ms"] =
+        percentiles(r.usesField ? r.sdfBuildMs : std::vector<double>{}, medianP95);
+    row["solve_us"] = percentiles(r.solveUs, medianP95);
     if (!r.checkUs.empty()) {
-      out << ", \"check_us\": {\"median\": " << jsonNumber(percentile(r.checkUs, 0.5))
-          << ", \"p95\": " << jsonNumber(percentile(r.checkUs, 0.95)) << "}"
-          << ", \"exact_samples_mean\": "
-          << jsonNumber(double(r.exactSamples) / double(r.checkUs.size()));
+      row["check_us"] = percentiles(r.checkUs, medianP95);
+      row["exact_samples_mean"] = jsonNumber(double(r.exactSamples) / double(r.checkUs.size()));
     }
-    out << ",\n     \"tip_residual_mm\": {\"median\": "
-        << jsonNumber(percentile(r.tipResidualMm, 0.5))
-        << ", \"p95\": " << jsonNumber(percentile(r.tipResidualMm, 0.95)) << "}"
-        << ", \"contact_residual_mm\": {\"median\": "
-        << jsonNumber(percentile(r.contactResidualMm, 0.5))
-        << ", \"p95\": " << jsonNumber(percentile(r.contactResidualMm, 0.95)) << "}"
-        << ",\n     \"contact_fingers\": " << jsonCounts(r.contactFingers)
-        << ", \"tip_contact_fingers\": " << jsonCounts(r.tipContactFingers)
-        << ", \"pass_through\": " << r.passThroughs
-        << ",\n     \"penetration_mm\": {\"p99\": " << jsonNumber(percentile(r.penetrationMm, 0.99))
-        << ", \"max\": " << jsonNumber(percentile(r.penetrationMm, 1.0)) << "}"
-        << ", \"early_stops\": " << r.earlyStops
-        << ", \"contacts_mean\": " << jsonNumber(r.contactsMean()) << "}";
+    row["tip_residual_mm"] = percentiles(r.tipResidualMm, medianP95);
+    row["contact_residual_mm"] = percentiles(r.contactResidualMm, medianP95);
+    // Per finger, thumb to little.
+    row["contact_fingers"] = r.contactFingers;
+    row["tip_contact_fingers"] = r.tipContactFingers;
+    row["pass_through"] = r.passThroughs;
+    row["penetration_mm"] = percentiles(r.penetrationMm, {{"p99", 0.99}, {"max", 1.0}});
+    row["early_stops"] = r.earlyStops;
+    row["contacts_mean"] = jsonNumber(r.contactsMean());
+    rowsOut.push_back(std::move(row));
   }
-  out << "\n  ]\n}\n";
-  out.flush();
-  return bool(out);
+  return out;
+}
+
+bool writeJson(const std::string& file, const Options& o, const std::vector<Row>& rows) {
+  return !tools::writeJsonFile(file, resultsJson(o, rows)).has_value();
 }
 
 void printTables(const Options& o, const std::vector<Row>& rows) {

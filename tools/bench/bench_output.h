@@ -6,10 +6,15 @@
 #include <vector>
 
 #include "bench_options.h"
+#include "json_file.h"
 #include "run_mesh.h"
 
 namespace sdfg::bench {
 
+// The run as the JSON that docs quote and --report reads: the settings, the provenance of the
+// build (json_file.h), and one object per row with its figures (null where there are none).
+tools::Json resultsJson(const Options& o, const std::vector<Row>& rows);
+// resultsJson() into `file`; false when it cannot be written.
 bool writeJson(const std::string& file, const Options& o, const std::vector<Row>& rows);
 void printTables(const Options& o, const std::vector<Row>& rows);
 

@@ -11,11 +11,11 @@
 #include <sstream>
 #include <thread>
 #include <tuple>
-#include <variant>
 
 #include "eval/evaluator.h"
 #include "hand/hand_model.h"
 
+#include "build_info.h"
 #include "report_detail.h"
 
 namespace fs = std::filesystem;
@@ -41,9 +41,9 @@ struct Column {
   std::string sub;  // member of that object, or empty for a plain number
   std::string title() const { return sub.empty() ? key : key + " " + sub; }
   double get(const Json& row) const {
-    const Json* v = row.find(key);
-    if (v && !sub.empty()) v = v->find(sub);
-    return v ? v->number() : std::nan("");
+    const Json* v = member(row, key);
+    if (v && !sub.empty()) v = member(*v, sub);
+    return numberOf(v);
   }
 };
 
@@ -147,20 +147,10 @@ std::string linePlot(const std::string& dat, const std::string& png, const std::
 }  // namespace
 
 std::optional<Error> writeReport(const ReportRequest& request, const ScalingResults* scaling) {
-  std::ifstream in(request.resultsJson);
-  if (!in) {
-    return makeError(Status::io_error, request.resultsJson.string() + ": cannot read");
-  }
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  const std::string text = buffer.str();
-  std::string parseError;
-  const std::optional<Json> json = parseJson(text, parseError);
-  if (!json) {
-    return makeError(Status::io_error, request.resultsJson.string() + ": " + parseError);
-  }
-  const Json* rowsJson = json->find("rows");
-  if (!rowsJson || !rowsJson->array()) {
+  const Result<Json> json = tools::readJsonFile(request.resultsJson);
+  if (!json) return json.error();
+  const Json* rowsJson = member(*json, "rows");
+  if (!rowsJson || !rowsJson->is_array()) {
     return makeError(Status::io_error, request.resultsJson.string() + ": no \"rows\" array");
   }
 
@@ -177,15 +167,15 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
   std::vector<Column> quality;
   const std::vector<std::string> identity = {"mesh",      "method",   "sdf_backend",
                                              "triangles", "solve_us", "sdf_build_ms"};
-  for (const Json& row : *rowsJson->array()) {
-    std::string mesh = row.find("mesh") ? row.find("mesh")->string() : "";
-    const std::string method = row.find("method") ? row.find("method")->string() : "";
+  for (const Json& row : *rowsJson) {
+    std::string mesh = stringOf(member(row, "mesh"));
+    const std::string method = stringOf(member(row, "method"));
     // Results written before the backend column were all CPU builds.
-    const Json* backendJson = row.find("sdf_backend");
-    const Variant variant{method, backendJson ? backendJson->string() : tools::kCpuBackend};
+    const Json* backendJson = member(row, "sdf_backend");
+    const Variant variant{method, backendJson ? stringOf(backendJson) : tools::kCpuBackend};
     // Two meshes of one name (the embedded torus and torus.obj): the later one is "name (2)".
     for (int n = 2; table.at(mesh, variant); ++n) {
-      mesh = (row.find("mesh") ? row.find("mesh")->string() : "") + " (" + std::to_string(n) + ")";
+      mesh = stringOf(member(row, "mesh")) + " (" + std::to_string(n) + ")";
     }
     if (std::find(table.meshes.begin(), table.meshes.end(), mesh) == table.meshes.end()) {
       table.meshes.push_back(mesh);
@@ -198,15 +188,15 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
       table.backends.push_back(variant.backend);
     }
     table.rows[{mesh, variant.method, variant.backend}] = &row;
-    if (const Json::Object* members = row.object()) {
-      for (const auto& [key, value] : *members) {
+    if (row.is_object()) {
+      for (const auto& [key, value] : row.items()) {
         if (std::find(identity.begin(), identity.end(), key) != identity.end()) continue;
         std::vector<Column> found;
-        if (const Json::Object* sub = value.object()) {
-          for (const auto& [subKey, subValue] : *sub) {
-            if (subValue.isNumber() || subValue.isNull()) found.push_back({key, subKey});
+        if (value.is_object()) {
+          for (const auto& [subKey, subValue] : value.items()) {
+            if (subValue.is_number() || subValue.is_null()) found.push_back({key, subKey});
           }
-        } else if (value.isNumber() || value.isNull()) {
+        } else if (value.is_number() || value.is_null()) {
           found.push_back({key, ""});
         }
         for (const Column& c : found) {
@@ -222,11 +212,11 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
   // Every top-level number or flag of the JSON (placements, seed, da, resolution, exact_check...)
   // as "key value".
   std::string settings;
-  for (const auto& [key, value] : *json->object()) {
-    if (value.isNumber()) {
-      settings += (settings.empty() ? "" : ", ") + key + " " + fmt(value.number());
-    } else if (const bool* flag = std::get_if<bool>(&value.v)) {
-      settings += (settings.empty() ? "" : ", ") + key + (*flag ? " on" : " off");
+  for (const auto& [key, value] : json->items()) {
+    if (value.is_number()) {
+      settings += (settings.empty() ? "" : ", ") + key + " " + fmt(value.get<double>());
+    } else if (value.is_boolean()) {
+      settings += (settings.empty() ? "" : ", ") + key + (value.get<bool>() ? " on" : " off");
     }
   }
   std::ostringstream md;
@@ -242,7 +232,23 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
     std::string a, b, c;
     if (loadavg >> a >> b >> c) load = a + ", " + b + ", " + c;
   }
+  // Which code made the figures: the commit each JSON recorded (a JSON from before the bench
+  // recorded it says so), and the code that wrote this page.
+  auto commitOf = [](const Json* provenance, const fs::path& file, const std::string& what) {
+    if (auto described = tools::describeProvenance(provenance ? *provenance : Json())) {
+      return *described;
+    }
+    return "not recorded: `" + file.string() + "` was written before " + what +
+           " recorded its commit";
+  };
   md << "| | |\n|---|---|\n"
+     << "| commit of the figures (bench run) | "
+     << commitOf(member(*json, "provenance"), request.resultsJson, "the bench") << " |\n";
+  if (scaling) {
+    md << "| commit of the SDF scaling figures | "
+       << commitOf(&scaling->provenance, request.scalingFrom, "the sweep") << " |\n";
+  }
+  md << "| commit of the report's writer | " << tools::describeBuild() << " |\n"
      << "| date | " << nowUtc() << " |\n"
      << "| CPU | " << (cpu.empty() ? "unknown" : cpu) << " |\n"
      << "| hardware threads (nproc) | " << std::thread::hardware_concurrency() << " |\n"
@@ -334,9 +340,9 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
   for (const auto& mesh : table.meshes) {
     const Json* t = nullptr;
     for (const Variant& v : table.variants) {
-      if (const Json* r = table.at(mesh, v); r && !t) t = r->find("triangles");
+      if (const Json* r = table.at(mesh, v); r && !t) t = member(*r, "triangles");
     }
-    md << " " << (t && t->isNumber() ? withThousands(size_t(t->number())) : "-") << " |";
+    md << " " << (t && t->is_number() ? withThousands(size_t(numberOf(t))) : "-") << " |";
   }
   md << "\n\n![solve time](img/bench/solve_time.png)\n\n";
 

@@ -21,6 +21,7 @@
 
 #include "base/pose.h"
 #include "base/status.h"
+#include "json_file.h"
 #include "mesh/mesh.h"
 #include "mesh/mesh_distance.h"
 #include "sdf/sdf_grid.h"
@@ -66,6 +67,9 @@ struct ScalingResults {
   int repeats = 0;
   std::vector<ScalingPoint> byTriangles;   // sorted by triangle count
   std::vector<ScalingPoint> byResolution;  // one mesh (the ~100k torus), rising resolution
+  // The build that ran the sweep (json_file.h: provenanceJson()); null when it was read from a
+  // JSON written before the bench recorded it.
+  tools::Json provenance;
 };
 
 // Runs both sweeps; progress lines go to stderr. Errors name the mesh or builder that failed; a
@@ -99,18 +103,15 @@ ReportStatus runReport(const ReportRequest& request);
 // The report alone, from the JSON and (optionally) a sweep already run; errors as runReport().
 std::optional<Error> writeReport(const ReportRequest& request, const ScalingResults* scaling);
 
-// The sweep as JSON: backends, devices, unavailable, repeats, and by_triangles / by_resolution
-// points {mesh, triangles, resolution, setup_ms, build_ms {backend: ms}, build_sample_ms {...}}.
+// The sweep as JSON: backends, devices, unavailable, repeats, provenance (when known), and
+// by_triangles / by_resolution points {mesh, triangles, resolution, setup_ms, build_ms {backend:
+// ms}, build_sample_ms {...}}.
 // Errors: io_error naming the file.
 std::optional<Error> writeScalingJson(const std::filesystem::path& file,
                                       const ScalingResults& results);
 
 // A sweep written by writeScalingJson(). Errors: io_error naming the file and the problem.
 Result<ScalingResults> readScalingJson(const std::filesystem::path& file);
-
-// JSON text of a string (quoted, escaped) and of a number ("null" when not finite, else %.6g).
-std::string jsonString(const std::string& s);
-std::string jsonNumber(double v);
 
 // Where --report puts the bench's JSON when --json is not given (creates the folder).
 std::filesystem::path reportResultsPath(const std::filesystem::path& dir);

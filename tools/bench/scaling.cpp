@@ -5,10 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
-#include <map>
 #include <sstream>
-#include <thread>
 
 #include "eval/evaluator.h"
 #include "eval/placements.h"
@@ -122,6 +119,7 @@ Result<ScalingResults> runScaling(const ScalingOptions& options) {
   ScalingBuilders made = makeScalingBuilders(options.backends, options.threads);
   ScalingResults results;
   results.repeats = options.repeats;
+  results.provenance = tools::provenanceJson();
   results.unavailable = made.unavailable;
   for (const std::string& u : made.unavailable) {
     std::fprintf(stderr, "autograsp-bench: scaling: %s; its column is left out\n", u.c_str());
@@ -248,56 +246,49 @@ void printScaling(const ScalingResults& results) {
 }
 
 std::optional<Error> writeScalingJson(const fs::path& file, const ScalingResults& r) {
-  std::ofstream out(file);
-  auto strings = [](const std::vector<std::string>& v) {
-    std::string a = "[";
-    for (size_t i = 0; i < v.size(); ++i) a += (i ? ", " : "") + jsonString(v[i]);
-    return a + "]";
-  };
+  using tools::jsonNumber;
   // Per builder, by name: {"cpu": 1.2, "vulkan": 30}.
   auto perBuilder = [&](const std::vector<double>& ms) {
-    std::string o = "{";
+    Json o = Json::object();
     for (size_t i = 0; i < ms.size() && i < r.builders.size(); ++i) {
-      o += (i ? ", " : "") + jsonString(r.builders[i]) + ": " + jsonNumber(ms[i]);
+      o[r.builders[i]] = jsonNumber(ms[i]);
     }
-    return o + "}";
+    return o;
   };
   auto points = [&](const std::vector<ScalingPoint>& v) {
-    std::string a = "[";
-    for (size_t i = 0; i < v.size(); ++i) {
-      const ScalingPoint& p = v[i];
-      a += std::string(i ? ",\n" : "\n") + "    {\"mesh\": " + jsonString(p.mesh) +
-           ", \"triangles\": " + std::to_string(p.triangles) +
-           ", \"resolution\": " + std::to_string(p.resolution) +
-           ", \"setup_ms\": " + jsonNumber(p.prepareMs) +
-           ",\n     \"build_ms\": " + perBuilder(p.buildMs) +
-           ", \"build_sample_ms\": " + perBuilder(p.buildSampleMs) + "}";
+    Json a = Json::array();
+    for (const ScalingPoint& p : v) {
+      Json point;
+      point["mesh"] = p.mesh;
+      point["triangles"] = p.triangles;
+      point["resolution"] = p.resolution;
+      point["setup_ms"] = jsonNumber(p.prepareMs);
+      point["build_ms"] = perBuilder(p.buildMs);
+      point["build_sample_ms"] = perBuilder(p.buildSampleMs);
+      a.push_back(std::move(point));
     }
-    return a + "\n  ]";
+    return a;
   };
-  out << "{\n  \"backends\": " << strings(r.builders) << ",\n  \"devices\": " << strings(r.devices)
-      << ",\n  \"unavailable\": " << strings(r.unavailable) << ",\n  \"repeats\": " << r.repeats
-      << ",\n  \"by_triangles\": " << points(r.byTriangles)
-      << ",\n  \"by_resolution\": " << points(r.byResolution) << "\n}\n";
-  out.flush();
-  if (!out) return makeError(Status::io_error, file.string() + ": cannot write");
-  return std::nullopt;
+  Json out;
+  out["backends"] = r.builders;
+  out["devices"] = r.devices;
+  out["unavailable"] = r.unavailable;
+  out["repeats"] = r.repeats;
+  if (!r.provenance.is_null()) out["provenance"] = r.provenance;
+  out["by_triangles"] = points(r.byTriangles);
+  out["by_resolution"] = points(r.byResolution);
+  return tools::writeJsonFile(file, out);
 }
 
 Result<ScalingResults> readScalingJson(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) return makeError(Status::io_error, file.string() + ": cannot read");
-  std::stringstream text;
-  text << in.rdbuf();
-  const std::string body = text.str();
-  std::string error;
-  const std::optional<Json> json = parseJson(body, error);
-  if (!json) return makeError(Status::io_error, file.string() + ": " + error);
+  Result<Json> read = tools::readJsonFile(file);
+  if (!read) return read.error();
+  const Json& json = *read;
   ScalingResults r;
   auto strings = [&](const char* key) {
     std::vector<std::string> out;
-    if (const Json* a = json->find(key); a && a->array()) {
-      for (const Json& v : *a->array()) out.push_back(v.string());
+    if (const Json* a = member(json, key); a && a->is_array()) {
+      for (const Json& v : *a) out.push_back(stringOf(&v));
     }
     return out;
   };
@@ -305,19 +296,20 @@ Result<ScalingResults> readScalingJson(const fs::path& file) {
   r.devices = strings("devices");
   r.unavailable = strings("unavailable");
   r.devices.resize(r.builders.size());
-  const Json* repeats = json->find("repeats");
-  r.repeats = repeats ? int(repeats->number()) : 0;
+  const double repeats = numberOf(member(json, "repeats"));
+  r.repeats = std::isfinite(repeats) ? int(repeats) : 0;
+  if (const Json* p = member(json, "provenance")) r.provenance = *p;
   auto number = [](const Json& object, const char* key, const std::string& sub = {}) {
-    const Json* v = object.find(key);
-    if (v && !sub.empty()) v = v->find(sub);
-    return v ? v->number() : std::nan("");
+    const Json* v = member(object, key);
+    if (v && !sub.empty()) v = member(*v, sub);
+    return numberOf(v);
   };
   auto points = [&](const char* key, std::vector<ScalingPoint>& out) -> bool {
-    const Json* a = json->find(key);
-    if (!a || !a->array()) return false;
-    for (const Json& p : *a->array()) {
+    const Json* a = member(json, key);
+    if (!a || !a->is_array()) return false;
+    for (const Json& p : *a) {
       ScalingPoint point;
-      point.mesh = p.find("mesh") ? p.find("mesh")->string() : "";
+      point.mesh = stringOf(member(p, "mesh"));
       point.triangles = size_t(std::max(0.0, number(p, "triangles")));
       point.resolution = int(std::max(0.0, number(p, "resolution")));
       point.prepareMs = number(p, "setup_ms");

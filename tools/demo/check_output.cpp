@@ -4,10 +4,12 @@
 // colours, the object's blue-grey and the hand's skin tone, and the image has contact magenta;
 // <object>-sdf-slice.png is WIDTH x WIDTH with inside blue, outside red and the black surface.
 // report.md and report.html exist, show every picture, have 15 finger rows per object and no
-// non-finite number. Prints each failed check; exit status 1 when any failed.
+// non-finite number, and name the commit of the code that made them. Prints each failed check; exit
+// status 1 when any failed.
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -90,6 +92,10 @@ int main(int argc, char** argv) {
   check(!md.empty(), "report.md present");
   check(!html.empty() && html.find("</html>") != std::string::npos, "report.html present");
   check(!hasNonFinite(md) && !hasNonFinite(html), "no nan or inf in the reports");
+  // The code that made them: a full commit hash, or "unknown" outside a git checkout.
+  const std::regex commit("Code: git commit ([0-9a-f]{40} \\(|unknown )");
+  check(std::regex_search(md, commit) && std::regex_search(html, commit),
+        "the reports name the commit of the code");
   size_t rows = 0;
   for (size_t at = md.find("\n| "); at != std::string::npos; at = md.find("\n| ", at + 1)) ++rows;
   // One header row per object, then 5 fingers x 3 strategies.

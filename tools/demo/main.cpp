@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "build_info.h"
+#include "cli_options.h"
 #include "demo_config.h"
 #include "eval/solver_physics.h"
 #include "eval/strategies.h"
@@ -68,46 +70,24 @@ void usage(FILE* f) {
       SDFG_DEMO_SHARED_MESHES);
 }
 
+// Fills `o`; false after printing why (exit 2). --help prints the usage and exits 0.
 bool parse(int argc, char** argv, Options& o) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&](const char* name) -> const char* {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "autograsp-demo: %s needs a value\n", name);
-        return nullptr;
-      }
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
-      usage(stdout);
-      std::exit(0);
-    } else if (a == "--out") {
-      const char* v = value("--out");
-      if (!v) return false;
-      o.out = v;
-    } else if (a == "--mesh") {
-      const char* v = value("--mesh");
-      if (!v) return false;
-      o.meshes.push_back(v);
-    } else if (a == "--embedded-only") {
-      o.embeddedOnly = true;
-    } else if (a == "--width" || a == "--resolution") {
-      const char* v = value(a.c_str());
-      if (!v) return false;
-      char* end = nullptr;
-      const long n = std::strtol(v, &end, 10);
-      const bool isWidth = a == "--width";
-      const long lo = isWidth ? 256 : 2, hi = isWidth ? 2048 : 128;
-      if (*end != '\0' || n < lo || n > hi) {
-        std::fprintf(stderr, "autograsp-demo: %s must be a number in %ld..%ld, not '%s'\n",
-                     a.c_str(), lo, hi, v);
-        return false;
-      }
-      (isWidth ? o.width : o.resolution) = uint32_t(n);
-    } else {
-      std::fprintf(stderr, "autograsp-demo: unknown argument '%s' (see --help)\n", a.c_str());
-      return false;
-    }
+  namespace cli = tools::cli;
+  CLI::App app{"", "autograsp-demo"};
+  bool help = false;
+  cli::addHelpFlag(app, help);
+  cli::addName(app, "--out", o.out, "folder name");
+  cli::addRepeatable(app, "--mesh", o.meshes);
+  app.add_flag("--embedded-only", o.embeddedOnly);
+  cli::addInteger(app, "--width", o.width, 256, 2048);
+  cli::addInteger(app, "--resolution", o.resolution, kMinGridResolution, kMaxGridResolution);
+  if (auto error = cli::parse(app, argc, argv)) {
+    std::fprintf(stderr, "autograsp-demo: %s (see --help)\n", error->c_str());
+    return false;
+  }
+  if (help) {
+    usage(stdout);
+    std::exit(0);
   }
   return true;
 }
@@ -268,6 +248,7 @@ int main(int argc, char** argv) {
   ReportInfo info;
   info.width = int(opt.width);
   info.environment = prepareEnvironment();
+  info.commit = tools::describeBuild();
   XrApp app;
   std::string error;
   if (!app.init(error)) {

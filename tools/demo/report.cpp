@@ -143,6 +143,7 @@ bool writeReports(const std::string& dir, const std::vector<ObjectResult>& objec
   md << "# SDF Autograsp demo\n\n" << kExplain << "\n\n";
   md << "Runtime: " << info.runtime << "; Vulkan device: " << info.device << "; "
      << info.environment << "; panel width " << info.width << " px.\n\n";
+  md << "Code: git commit " << info.commit << ".\n\n";
   html << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>SDF Autograsp demo</title>"
        << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
        // Pictures and tables shrink to the page (a picture row is three panels wide), text is
@@ -159,7 +160,8 @@ bool writeReports(const std::string& dir, const std::vector<ObjectResult>& objec
        << ".fail{color:#b00}</style></head><body>\n"
        << "<h1>SDF Autograsp demo</h1>\n<p>" << inlineHtml(kExplain)
        << "</p>\n<p>Runtime: " << escape(info.runtime) << "; Vulkan device: " << escape(info.device)
-       << "; " << escape(info.environment) << "; panel width " << info.width << " px.</p>\n";
+       << "; " << escape(info.environment) << "; panel width " << info.width << " px.</p>\n"
+       << "<p>Code: git commit " << escape(info.commit) << ".</p>\n";
   if (!info.failures.empty()) {
     md << "## Meshes skipped\n\n";
     html << "<h2>Meshes skipped</h2><ul>\n";

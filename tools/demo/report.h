@@ -44,6 +44,7 @@ struct ObjectResult {
 
 struct ReportInfo {
   std::string runtime, device, environment;
+  std::string commit;  // the code that made the report (build_info.h: describeBuild())
   int width = 0;
   std::vector<std::string> failures;  // meshes that could not be used, with the reason
 };

@@ -15,12 +15,7 @@
 // shown; its length is the grab latency in frames), held (still), held moving (30 degrees over 60
 // frames about the object's vertical axis), held deforming (vertices rescaled every frame).
 //
-// Usage: autograsp-frame-cost [--embedded-only] [--frames N] [--json FILE] [--mesh NAME]...
-//   --frames N       frames per phase (default 60; the smoke test uses a few)
-//   --embedded-only  skip ../shared/meshes (the bunny and the armadillos)
-//   --only NAME      measure only the object called NAME (repeatable)
-//   --json FILE      write the results (default docs/results/frame-cost.json is not assumed:
-//                    without --json nothing is written)
+// Options: kUsage below (--help prints it).
 #include <openxr/openxr.h>
 
 #include <openxr/XR_SDFG_auto_grasp.h>
@@ -33,7 +28,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -43,22 +38,34 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "build_info.h"
+#include "cli_options.h"
 #include "frame_cost_config.h"
 #include "hand/hand_model.h"
 #include "hand/hand_synthesis.h"
 #include "io/mesh_io.h"
 #include "io/shapes.h"
 #include "mock_runtime_test.h"
+#include "results.h"
 #include "sdf/sdf_grid.h"
 
 namespace {
 
+using namespace sdfg::frame_cost;
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
 constexpr auto kFramePeriod = std::chrono::nanoseconds(11'111'111);  // 90 Hz
-const char* const kPhases[] = {"open", "grab", "held", "held_moving", "held_deforming"};
-constexpr int kPhaseCount = 5;
+
+const char* const kUsage =
+    "usage: autograsp-frame-cost [--frames N] [--embedded-only] [--only NAME]... [--json FILE]\n"
+    "  --frames N       frames per phase (default 60, at least 2; the smoke test uses a few)\n"
+    "  --embedded-only  skip ../shared/meshes (the bunny and the armadillos)\n"
+    "  --only NAME      measure only the object called NAME (repeatable)\n"
+    "  --json FILE      write the results as JSON (without it nothing is written)\n"
+    "  --help           this text\n"
+    "exit codes: 0 every object measured; 1 an object failed or the JSON could not be written;\n"
+    "2 bad option\n";
 
 double ms(Clock::duration d) {
   return std::chrono::duration<double, std::milli>(d).count();
@@ -88,26 +95,6 @@ Object toObject(const std::string& name, const sdfg::TriangleMesh& m, float exte
   return o;
 }
 
-struct Percentiles {
-  double p50 = 0, p99 = 0, max = 0;
-  size_t count = 0;
-};
-
-Percentiles percentiles(std::vector<double> v) {
-  Percentiles p;
-  p.count = v.size();
-  if (v.empty()) return p;
-  std::sort(v.begin(), v.end());
-  auto at = [&](double q) {
-    const size_t i = size_t(std::ceil(q * double(v.size()))) - 1;
-    return v[std::min(i, v.size() - 1)];
-  };
-  p.p50 = at(0.5);
-  p.p99 = at(0.99);
-  p.max = v.back();
-  return p;
-}
-
 std::string gripLine(uint64_t frame, const XrPosef& p) {
   char buf[256];
   std::snprintf(buf, sizeof buf, "%llu right grip %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n",
@@ -121,22 +108,6 @@ std::string squeezeLine(uint64_t frame, float value) {
   std::snprintf(buf, sizeof buf, "%llu right squeeze %.3f\n", (unsigned long long)frame, value);
   return buf;
 }
-
-// What one run (layer on or off) measured.
-struct RunResult {
-  bool ok = false;
-  std::string error;
-  // Per phase, the app's time in OpenXR calls for each frame (ms).
-  std::array<std::vector<double>, kPhaseCount> frameMs;
-  // Per call name, all frames (ms), for the breakdown.
-  std::map<std::string, std::vector<double>> callMs;
-  int grabLatencyFrames = -1;  // frames from the squeeze to the shown grasp; -1: never
-  bool grasped = false;
-  double createMs = 0;  // the xrCreateGraspTargetSDFG call
-  double setupMs = 0;   // from create until the target is ready
-  double maxUpdateCallMs = 0;
-  std::array<uint64_t, kPhaseCount> builds{};  // CPU grab-box builds during each phase
-};
 
 class App {
  public:
@@ -496,87 +467,31 @@ RunResult run(const Object& object, bool layer, int phaseFrames) {
   return out;
 }
 
-struct MeshResult {
-  std::string name;
-  size_t triangles = 0;
-  bool ok = false;
-  std::string error;
-  RunResult on, off;
-  std::array<Percentiles, kPhaseCount> added;
-  std::array<double, kPhaseCount> offMedian{};
-  std::array<Percentiles, kPhaseCount> offStats;  // the layer-off run's own frame totals
-};
-
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4f", v);
-  return buf;
-}
-
-void writeJson(const std::string& path, const std::vector<MeshResult>& results, int phaseFrames,
-               const std::vector<std::string>& skipped) {
-  std::ofstream f(path);
-  f << "{\n  \"tool\": \"autograsp-frame-cost\",\n  \"frames_per_phase\": " << phaseFrames
-    << ",\n  \"frame_period_ms\": " << fmt(ms(kFramePeriod))
-    << ",\n  \"hardware_threads\": " << std::thread::hardware_concurrency()
-    << ",\n  \"skipped\": [";
-  for (size_t i = 0; i < skipped.size(); ++i) f << (i ? ", " : "") << "\"" << skipped[i] << "\"";
-  f << "],\n  \"meshes\": [\n";
-  for (size_t m = 0; m < results.size(); ++m) {
-    const MeshResult& r = results[m];
-    f << "    {\n      \"name\": \"" << r.name << "\",\n      \"triangles\": " << r.triangles
-      << ",\n      \"ok\": " << (r.ok ? "true" : "false") << ",\n      \"error\": \"" << r.error
-      << "\",\n      \"create_call_ms\": " << fmt(r.on.createMs)
-      << ",\n      \"setup_ms\": " << fmt(r.on.setupMs)
-      << ",\n      \"max_vertex_update_call_ms\": " << fmt(r.on.maxUpdateCallMs)
-      << ",\n      \"grab_latency_frames\": " << r.on.grabLatencyFrames
-      << ",\n      \"phases\": {\n";
-    for (int p = 0; p < kPhaseCount; ++p) {
-      const Percentiles& a = r.added[p];
-      f << "        \"" << kPhases[p] << "\": {\"frames\": " << a.count
-        << ", \"added_p50_ms\": " << fmt(a.p50) << ", \"added_p99_ms\": " << fmt(a.p99)
-        << ", \"added_max_ms\": " << fmt(a.max) << ", \"off_median_ms\": " << fmt(r.offMedian[p])
-        << ", \"off_p99_ms\": " << fmt(r.offStats[p].p99)
-        << ", \"off_max_ms\": " << fmt(r.offStats[p].max) << ", \"cpu_builds\": " << r.on.builds[p]
-        << "}" << (p + 1 < kPhaseCount ? "," : "") << "\n";
-    }
-    f << "      },\n      \"calls_on\": {";
-    bool first = true;
-    for (const auto& [name, v] : r.on.callMs) {
-      const Percentiles c = percentiles(v);
-      f << (first ? "\n" : ",\n") << "        \"" << name << "\": {\"p50_ms\": " << fmt(c.p50)
-        << ", \"p99_ms\": " << fmt(c.p99) << ", \"max_ms\": " << fmt(c.max) << "}";
-      first = false;
-    }
-    f << "\n      }\n    }" << (m + 1 < results.size() ? "," : "") << "\n";
-  }
-  f << "  ]\n}\n";
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   int phaseFrames = 60;
-  bool embeddedOnly = false;
+  bool embeddedOnly = false, help = false;
   std::string json;
-  std::set<std::string> only;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--frames" && i + 1 < argc) {
-      phaseFrames = std::max(2, std::atoi(argv[++i]));
-    } else if (a == "--embedded-only") {
-      embeddedOnly = true;
-    } else if (a == "--json" && i + 1 < argc) {
-      json = argv[++i];
-    } else if (a == "--only" && i + 1 < argc) {
-      only.insert(argv[++i]);
-    } else {
-      std::fprintf(stderr,
-                   "usage: autograsp-frame-cost [--frames N] [--embedded-only] [--only NAME]... "
-                   "[--json FILE]\n");
-      return 2;
-    }
+  std::vector<std::string> onlyNames;
+  CLI::App cli{"", "autograsp-frame-cost"};
+  sdfg::tools::cli::addHelpFlag(cli, help);
+  // Fewer than 2 frames per phase leave nothing to take percentiles of: raised to 2, as always.
+  sdfg::tools::cli::addInteger(
+      cli, "--frames", std::numeric_limits<int>::min(), std::numeric_limits<int>::max(),
+      [&](long long n) { phaseFrames = std::max(2, int(n)); }, "an integer");
+  cli.add_flag("--embedded-only", embeddedOnly);
+  sdfg::tools::cli::addName(cli, "--json", json, "file name");
+  sdfg::tools::cli::addRepeatable(cli, "--only", onlyNames);
+  if (auto error = sdfg::tools::cli::parse(cli, argc, argv)) {
+    std::fprintf(stderr, "autograsp-frame-cost: %s\n%s", error->c_str(), kUsage);
+    return 2;
   }
+  if (help) {
+    std::fputs(kUsage, stdout);
+    return 0;
+  }
+  const std::set<std::string> only(onlyNames.begin(), onlyNames.end());
   if (std::getenv("XR_RUNTIME_JSON") == nullptr)
     setenv("XR_RUNTIME_JSON", SDFG_FC_MOCK_RUNTIME_JSON, 1);
   setenv("SDFG_MOCK_HAND_TRACKING", "absent", 1);  // controllers only: the layer makes the hands
@@ -634,8 +549,8 @@ int main(int argc, char** argv) {
 
   std::printf(
       "\nTime the layer adds to the app's OpenXR calls per frame (ms; layer on minus the "
-      "layer-off median of the phase), 90 Hz pacing, %d frames per phase\n\n",
-      phaseFrames);
+      "layer-off median of the phase), 90 Hz pacing, %d frames per phase; code at commit %s\n\n",
+      phaseFrames, sdfg::tools::describeBuild().c_str());
   std::printf("| object | triangles | create call | set-up | grab latency (frames) |");
   for (const char* p : kPhases) std::printf(" %s p50 / p99 / max |", p);
   std::printf("\n|---|---:|---:|---:|---:|");
@@ -655,7 +570,11 @@ int main(int argc, char** argv) {
   }
   for (const std::string& s : skipped) std::printf("| %s | skipped: not found |\n", s.c_str());
   if (!json.empty()) {
-    writeJson(json, results, phaseFrames, skipped);
+    if (auto error = sdfg::tools::writeJsonFile(
+            json, resultsJson(results, phaseFrames, ms(kFramePeriod), skipped))) {
+      std::fprintf(stderr, "autograsp-frame-cost: %s\n", error->message.c_str());
+      return 1;
+    }
     std::printf("\nwrote %s\n", json.c_str());
   }
   return failures == 0 ? 0 : 1;

@@ -1,11 +1,7 @@
 // autograsp-sdf-scaling: grab-box SDF build time against triangle count and resolution, the CPU
 // builder and the Vulkan builder side by side in one run, with the speed-up ratio.
 //
-//   autograsp-sdf-scaling [--meshes DIR] [--runs N] [--res 16,32,64] [--quick] [--profile]
-//
-// --only torus|meshes keeps one group of rows. --wg sets the compute work-group size (default 64).
-// --profile adds the Vulkan pass times (GPU timestamps) of the last run to each row.
-// --far-band M runs the CPU builder in its far-field mode (CpuSdfOptions::exactBand = M metres).
+// Options: kUsage below (--help prints it).
 //
 // Objects (tools/common/sdf_backends.h, the same as autograsp-bench --scaling): a procedural torus
 // tessellated to 5k .. 400k triangles (the same surface at every count), then the shared test
@@ -24,11 +20,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "build_info.h"
+#include "cli_options.h"
 #include "mesh/mesh_distance.h"
 #include "sdf/sdf_grid.h"
 #include "sdf_backends.h"
@@ -38,44 +36,67 @@ namespace {
 using namespace sdfg;
 using Clock = std::chrono::steady_clock;
 
+const char* const kUsage =
+    "usage: autograsp-sdf-scaling [--meshes DIR] [--runs N] [--res 16,32,64] [--quick]\n"
+    "                             [--profile] [--wg N] [--only torus|meshes] [--far-band M]\n"
+    "  --meshes DIR       folder of the test meshes (default ../shared/meshes)\n"
+    "  --runs N           timed runs per row after one warm-up; the median is shown (default 5)\n"
+    "  --res LIST         comma-separated grid resolutions, 2..128 (default 16,32,64)\n"
+    "  --quick            tori up to 100k triangles only, no meshes\n"
+    "  --profile          add the Vulkan pass times (GPU timestamps) of the last run to each row\n"
+    "  --wg N             compute work-group size of the Vulkan builder (default 64)\n"
+    "  --only torus|meshes  keep one group of rows\n"
+    "  --far-band M       CPU builder far-field mode: CpuSdfOptions::exactBand = M metres\n"
+    "                     (default 0, exact everywhere)\n"
+    "  --help             this text\n"
+    "exit codes: 0 done; 1 the CPU builder failed; 2 bad option\n";
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  namespace cli = tools::cli;
   std::filesystem::path meshDir = "../shared/meshes";
   int runs = 5;
-  bool quick = false, torusRows = true, meshRows = true;
+  bool quick = false, torusRows = true, meshRows = true, help = false;
   tools::TimedBuilderOptions builderOptions;
   std::vector<uint32_t> resolutions = {16, 32, 64};
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--meshes" && i + 1 < argc) {
-      meshDir = argv[++i];
-    } else if (a == "--runs" && i + 1 < argc) {
-      runs = std::max(1, std::atoi(argv[++i]));
-    } else if (a == "--wg" && i + 1 < argc) {
-      builderOptions.vulkanWorkGroupSize = uint32_t(std::max(1, std::atoi(argv[++i])));
-    } else if (a == "--only" && i + 1 < argc) {
-      const std::string which = argv[++i];
-      torusRows = which == "torus";
-      meshRows = which == "meshes";
-    } else if (a == "--far-band" && i + 1 < argc) {
-      builderOptions.cpuExactBand = std::strtof(argv[++i], nullptr);
-    } else if (a == "--profile") {
-      builderOptions.vulkanProfile = true;
-    } else if (a == "--quick") {
-      quick = true;
-    } else if (a == "--res" && i + 1 < argc) {
-      resolutions.clear();
-      std::stringstream s(argv[++i]);
-      std::string r;
-      while (std::getline(s, r, ',')) resolutions.push_back(uint32_t(std::atoi(r.c_str())));
-    } else {
-      std::fprintf(stderr,
-                   "usage: %s [--meshes DIR] [--runs N] [--res 16,32,64] [--quick] [--profile] "
-                   "[--wg N] [--only torus|meshes] [--far-band M]\n",
-                   argv[0]);
-      return 2;
-    }
+  CLI::App app{"", "autograsp-sdf-scaling"};
+  cli::addHelpFlag(app, help);
+  std::string meshes;
+  cli::addName(app, "--meshes", meshes, "folder name");
+  // --runs and --wg below 1 are raised to 1, as they always were.
+  const long long intMin = std::numeric_limits<int>::min(),
+                  intMax = std::numeric_limits<int>::max();
+  cli::addInteger(
+      app, "--runs", intMin, intMax, [&](long long n) { runs = std::max(1, int(n)); },
+      "an integer");
+  cli::addInteger(
+      app, "--wg", intMin, intMax,
+      [&](long long n) { builderOptions.vulkanWorkGroupSize = uint32_t(std::max(1, int(n))); },
+      "an integer");
+  std::vector<std::string> only;
+  cli::addList(app, "--only", {"torus", "meshes"}, "group", only);
+  cli::addNumber(
+      app, "--far-band", builderOptions.cpuExactBand, [](float x) { return x >= 0.0f; },
+      "a distance >= 0 in metres");
+  app.add_flag("--profile", builderOptions.vulkanProfile);
+  app.add_flag("--quick", quick);
+  std::vector<long long> res;
+  cli::addIntegerList(app, "--res", kMinGridResolution, kMaxGridResolution, "resolution", res);
+  if (auto error = cli::parse(app, argc, argv)) {
+    std::fprintf(stderr, "autograsp-sdf-scaling: %s\n%s", error->c_str(), kUsage);
+    return 2;
+  }
+  if (help) {
+    std::fputs(kUsage, stdout);
+    return 0;
+  }
+  if (!meshes.empty()) meshDir = meshes;
+  if (!res.empty()) resolutions.assign(res.begin(), res.end());
+  if (!only.empty()) {
+    // --only torus,meshes keeps both, as no --only does.
+    torusRows = std::find(only.begin(), only.end(), "torus") != only.end();
+    meshRows = std::find(only.begin(), only.end(), "meshes") != only.end();
   }
 
   std::vector<tools::ScalingObject> objects;
@@ -108,6 +129,7 @@ int main(int argc, char** argv) {
   const std::vector<glm::vec3> points = tools::frameSamplePoints();
   std::printf("# autograsp-sdf-scaling: grab-box SDF build + 50 samples, median of %d runs\n",
               runs);
+  std::printf("# code at commit %s\n", tools::describeBuild().c_str());
   std::printf("# vulkan device: %s; cpu: %s, far-field band %g m\n",
               haveVulkan ? builders[1]->device().c_str() : "none", builders[0]->device().c_str(),
               double(builderOptions.cpuExactBand));

@@ -1,0 +1,70 @@
+#include "results.h"
+
+#include <algorithm>
+#include <cmath>
+#include <thread>
+
+namespace sdfg::frame_cost {
+
+Percentiles percentiles(std::vector<double> v) {
+  Percentiles p;
+  p.count = v.size();
+  if (v.empty()) return p;
+  std::sort(v.begin(), v.end());
+  auto at = [&](double q) {
+    const size_t i = size_t(std::ceil(q * double(v.size()))) - 1;
+    return v[std::min(i, v.size() - 1)];
+  };
+  p.p50 = at(0.5);
+  p.p99 = at(0.99);
+  p.max = v.back();
+  return p;
+}
+
+tools::Json resultsJson(const std::vector<MeshResult>& results, int phaseFrames,
+                        double framePeriodMs, const std::vector<std::string>& skipped) {
+  using tools::Json;
+  using tools::jsonNumber;
+  Json out;
+  out["tool"] = "autograsp-frame-cost";
+  out["frames_per_phase"] = phaseFrames;
+  out["frame_period_ms"] = jsonNumber(framePeriodMs);
+  out["hardware_threads"] = std::thread::hardware_concurrency();
+  out["provenance"] = tools::provenanceJson();
+  out["skipped"] = skipped;
+  Json& meshes = out["meshes"] = Json::array();
+  for (const MeshResult& r : results) {
+    Json m;
+    m["name"] = r.name;
+    m["triangles"] = r.triangles;
+    m["ok"] = r.ok;
+    m["error"] = r.error;
+    m["create_call_ms"] = jsonNumber(r.on.createMs);
+    m["setup_ms"] = jsonNumber(r.on.setupMs);
+    m["max_vertex_update_call_ms"] = jsonNumber(r.on.maxUpdateCallMs);
+    m["grab_latency_frames"] = r.on.grabLatencyFrames;
+    Json& phases = m["phases"] = Json::object();
+    for (int p = 0; p < kPhaseCount; ++p) {
+      const Percentiles& a = r.added[p];
+      phases[kPhases[p]] = {{"frames", a.count},
+                            {"added_p50_ms", jsonNumber(a.p50)},
+                            {"added_p99_ms", jsonNumber(a.p99)},
+                            {"added_max_ms", jsonNumber(a.max)},
+                            {"off_median_ms", jsonNumber(r.offMedian[p])},
+                            {"off_p99_ms", jsonNumber(r.offStats[p].p99)},
+                            {"off_max_ms", jsonNumber(r.offStats[p].max)},
+                            {"cpu_builds", r.on.builds[p]}};
+    }
+    Json& calls = m["calls_on"] = Json::object();
+    for (const auto& [name, v] : r.on.callMs) {
+      const Percentiles c = percentiles(v);
+      calls[name] = {{"p50_ms", jsonNumber(c.p50)},
+                     {"p99_ms", jsonNumber(c.p99)},
+                     {"max_ms", jsonNumber(c.max)}};
+    }
+    meshes.push_back(std::move(m));
+  }
+  return out;
+}
+
+}  // namespace sdfg::frame_cost

@@ -97,7 +97,10 @@ void MeshExactSource::sample(std::span<const glm::vec3> handPoints,
     o = ExactSample{};
     o.distance = mesh_->localSignedDistanceNear(objectFromHand_.transformPoint(handPoints[i]),
                                                 maxDistances[i], hint, &closest, &o.feature);
-    if (std::isfinite(o.distance)) o.closest = handFromObject_.transformPoint(closest);
+    if (std::isfinite(o.distance)) {
+      o.closest = handFromObject_.transformPoint(closest);
+      o.member = 0;
+    }
   }
 }
 

@@ -93,6 +93,9 @@ struct ExactSample {
   // this one returned (max(): none), which may make the search cheaper; it never changes the
   // result.
   uint32_t feature = std::numeric_limits<uint32_t>::max();
+  // Which solid the closest feature belongs to: a scene member's index (SceneExactSource), 0 for
+  // a single mesh; max() when none was found. Output only.
+  uint32_t member = std::numeric_limits<uint32_t>::max();
 };
 
 // Exact distance to the target at a few points, for strategies that check the stops they found

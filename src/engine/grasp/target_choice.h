@@ -1,0 +1,41 @@
+// Which target a grasp takes: the graspable object the closing hand actually touches, not the
+// one whose bounding box happens to be nearest (XR_SDFG_auto_grasp version 3).
+//
+// After the fingers have closed on the whole scene, each finger in contact touches the member
+// that owns the nearest surface at its touching sphere. The rule, deterministic:
+//   1. among the members the hand may take (SceneMember::graspable), the one the most fingers
+//      touch;
+//   2. between those, the one whose surface is nearest the palm (exact distance of the palm
+//      joint's centre);
+//   3. between those, the lowest id.
+// A member no finger touches is never taken; when the fingers touch only scene geometry, or
+// nothing, the hand holds nothing (its fingers still rest on what they touch).
+#pragma once
+
+#include <array>
+#include <span>
+
+#include <glm/vec3.hpp>
+
+#include "grasp/solver.h"
+#include "hand/hand_model.h"
+#include "scene/scene.h"
+
+namespace sdfg {
+
+struct GraspChoice {
+  int member = -1;  // index into the scene's members; -1: the hand holds nothing
+  // Per finger (thumb first), the member its contact touches; -1: no contact, or no surface
+  // within reach of the touching sphere.
+  std::array<int, kFingerCount> touched{-1, -1, -1, -1, -1};
+  int fingersOnChoice = 0;
+};
+
+// `scene`: the members' exact source (the one the solve used); `result`: the solve (contact
+// points in its corrected hand frame); `palm`: the palm joint's centre in the same frame as the
+// contact points; `reach`: how far from a touching sphere's centre its surface may be (the
+// sphere's radius plus the solver's tolerance; metres).
+GraspChoice chooseTarget(std::span<const SceneMember> members, const ExactDistanceSource& scene,
+                         const GraspResult& result, const glm::vec3& palm, float reach);
+
+}  // namespace sdfg

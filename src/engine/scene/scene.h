@@ -1,0 +1,36 @@
+// The solids a grasp sees in its grab box: every registered target whose bounds overlap the box
+// (the broad phase, scene_index.h), each as its exact distance (a mesh's MeshDistance or an
+// analytic shape) placed relative to the hand. The field a grasp solves on is their union
+// (scene_field.h), its exact check samples the nearest of them (grasp/scene_exact_source.h), and
+// which one a finger touches decides what the hand holds (grasp/target_choice.h).
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "base/pose.h"
+#include "mesh/mesh_distance.h"
+#include "scene/analytic_shape.h"
+
+namespace sdfg {
+
+// What a target is to the hands (XR_SDFG_auto_grasp version 3).
+enum class TargetRole : uint8_t {
+  graspable,  // hands grasp it and stop on it
+  scene,      // hands stop on it and never take it (tables, walls, a body)
+  ignored,    // hands pass through it
+};
+
+struct SceneMember {
+  uint64_t id = 0;                     // the target's id
+  const MeshDistance* mesh = nullptr;  // exactly one of mesh and shape is set
+  const AnalyticShape* shape = nullptr;
+  Pose objectFromHand;     // hand-space point -> the member's own frame
+  bool graspable = false;  // the hand of this grasp may take it (role and per-hand settings)
+};
+
+// At most this many members take part in one grasp: more targets than this in one grab box are
+// cut to the nearest (the exact source's feature ids carry the member index in 8 bits).
+inline constexpr size_t kMaxSceneMembers = 255;
+
+}  // namespace sdfg

@@ -1,0 +1,535 @@
+#include "grasp/outer_hand.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+namespace sdfg {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+// Parts within this of the margin constrain a sliding step.
+constexpr float kActiveBand = 0.004f;  // metres
+// A finger stops once its closest sphere is within this above the margin.
+constexpr float kContactTolerance = 0.0003f;  // metres
+// A turn costs as much as the motion it gives this far from the pivot (about half a hand).
+constexpr float kLever = 0.1f;  // metres
+constexpr int kDualSweeps = 100;
+constexpr int kMaxFingerSteps = 64;
+constexpr float kMinCurlStep = 1e-4f;
+// Spheres along a finger's bones are at most this many of the smaller joint radius apart.
+constexpr float kFingerSpacing = 0.7f;
+// How far the check for a released hand's coming out searches (a hand let go can be deep inside).
+constexpr float kReleasedReach = 1.0f;  // metres
+
+// The finger a part's bone belongs to, or -1 for the palm's sphere.
+int fingerOf(Joint joint) {
+  const int j = int(joint);
+  if (j < int(Joint::thumb_metacarpal)) return -1;
+  if (j <= int(Joint::thumb_tip)) return 0;
+  return 1 + (j - int(Joint::index_metacarpal)) / 5;
+}
+
+bool isMetacarpal(Joint joint) {
+  return joint == Joint::thumb_metacarpal || joint == Joint::index_metacarpal ||
+         joint == Joint::middle_metacarpal || joint == Joint::ring_metacarpal ||
+         joint == Joint::little_metacarpal;
+}
+
+bool finitePose(const Pose& p) {
+  const glm::quat& q = p.orientation;
+  return std::isfinite(p.position.x) && std::isfinite(p.position.y) &&
+         std::isfinite(p.position.z) && std::isfinite(q.w) && std::isfinite(q.x) &&
+         std::isfinite(q.y) && std::isfinite(q.z);
+}
+
+// The rotation vector of a unit quaternion (shortest way).
+glm::vec3 rotationVector(glm::quat q) {
+  if (q.w < 0.0f) q = -q;
+  const glm::vec3 v(q.x, q.y, q.z);
+  const float s = glm::length(v);
+  if (s < 1e-9f) return glm::vec3(0.0f);
+  return v * (2.0f * std::atan2(s, q.w) / s);
+}
+
+// A rigid motion of translation t and turn w (rotation vector) about the world point `pivot`,
+// applied after `pose`.
+Pose moved(const Pose& pose, const glm::vec3& pivot, const glm::vec3& t, const glm::vec3& w) {
+  const float angle = glm::length(w);
+  const glm::quat r = angle > 1e-9f ? glm::angleAxis(angle, w / angle) : glm::quat(1, 0, 0, 0);
+  return Pose{glm::normalize(r * pose.orientation), r * (pose.position - pivot) + pivot + t};
+}
+
+// Exact clearances of a set of spheres (world centres, radii to keep clear), one batch.
+class Probe {
+ public:
+  explicit Probe(const ExactDistanceSource& source) : source_(source) {}
+
+  // For each sphere: clearance (distance - radius; `reach - radius` when nothing is within
+  // `reach` of its centre and it is not known to be inside) and the unit gradient of the
+  // distance (zero when nothing was found). Returns the smallest clearance.
+  float operator()(std::span<const glm::vec3> centres, std::span<const float> radii, float reach,
+                   std::vector<float>& clearance, std::vector<glm::vec3>& gradient) {
+    const size_t n = centres.size();
+    bounds_.assign(n, 0.0f);
+    for (size_t i = 0; i < n; ++i) bounds_[i] = radii[i] + reach;
+    found_.resize(n);
+    if (hints_.size() != n) hints_.assign(n, std::numeric_limits<uint32_t>::max());
+    for (size_t i = 0; i < n; ++i) found_[i].feature = hints_[i];
+    source_.sample(centres, bounds_, found_);
+    samples += int(n);
+    clearance.resize(n);
+    gradient.resize(n);
+    float lowest = kInf;
+    for (size_t i = 0; i < n; ++i) {
+      const ExactSample& s = found_[i];
+      hints_[i] = s.feature;
+      gradient[i] = glm::vec3(0.0f);
+      if (!std::isfinite(s.distance)) {
+        clearance[i] = bounds_[i] - radii[i];
+      } else {
+        clearance[i] = s.distance - radii[i];
+        if (std::abs(s.distance) > 1e-7f) {
+          const glm::vec3 g = (centres[i] - s.closest) / s.distance;
+          const float gl = glm::length(g);
+          if (gl > 1e-3f) gradient[i] = g / gl;
+        }
+      }
+      lowest = std::min(lowest, clearance[i]);
+    }
+    return lowest;
+  }
+  void resetHints() { hints_.clear(); }
+  int samples = 0;
+
+ private:
+  const ExactDistanceSource& source_;
+  std::vector<float> bounds_;
+  std::vector<ExactSample> found_;
+  std::vector<uint32_t> hints_;
+};
+
+struct RigidParts {
+  std::vector<glm::vec3> local;  // wrist frame
+  std::vector<float> radius;     // cover radius
+};
+
+// Moves the rigid hand from `from` toward `goal` without any part crossing a surface; returns
+// where it ends. `pivotLocal`: the palm, wrist frame.
+Pose slide(const RigidParts& parts, const glm::vec3& pivotLocal, const Pose& from, const Pose& goal,
+           const ExactDistanceSource& source, const OuterHandOptions& o, int& samples) {
+  const size_t n = parts.local.size();
+  if (n == 0) return goal;
+  Probe probe(source);
+  std::vector<glm::vec3> world(n), gradient;
+  std::vector<float> clearance;
+  std::vector<std::array<float, 6>> rows;
+  std::vector<float> b, lambda, norm2;
+  Pose pose = from;
+  for (int it = 0; it < o.maxIterations; ++it) {
+    const glm::vec3 pivot = pose.transformPoint(pivotLocal);
+    const glm::vec3 tGoal = goal.transformPoint(pivotLocal) - pivot;
+    const glm::vec3 wGoal = rotationVector(goal.orientation * glm::conjugate(pose.orientation));
+    // The most any part moves on the way to the goal from here.
+    float farthest = 0.0f;
+    for (size_t i = 0; i < n; ++i) {
+      world[i] = pose.transformPoint(parts.local[i]);
+      farthest = std::max(farthest,
+                          glm::length(tGoal) + glm::length(wGoal) * glm::length(world[i] - pivot));
+    }
+    if (farthest < 1e-6f) return goal;
+    const float lowest =
+        probe(world, parts.radius, farthest + o.margin + kActiveBand, clearance, gradient);
+    // Free all the way (nothing within the motion): the goal itself.
+    if (lowest > farthest + o.margin) {
+      samples += probe.samples;
+      return goal;
+    }
+    // The constrained step: z = (t, kLever * w) nearest the goal's, every part within the band
+    // kept at the margin on its linearised distance. Dual projected Gauss-Seidel.
+    const std::array<float, 6> zGoal{tGoal.x,          tGoal.y,          tGoal.z,
+                                     kLever * wGoal.x, kLever * wGoal.y, kLever * wGoal.z};
+    rows.clear(), b.clear(), norm2.clear();
+    for (size_t i = 0; i < n; ++i) {
+      if (!(clearance[i] < o.margin + kActiveBand) || glm::dot(gradient[i], gradient[i]) < 0.25f)
+        continue;
+      const glm::vec3 g = gradient[i];
+      const glm::vec3 arm = glm::cross(world[i] - pivot, g) / kLever;
+      rows.push_back({g.x, g.y, g.z, arm.x, arm.y, arm.z});
+      float aa = 0.0f;
+      for (float v : rows.back()) aa += v * v;
+      norm2.push_back(aa);
+      b.push_back(o.margin - clearance[i]);
+    }
+    std::array<float, 6> z = zGoal;
+    lambda.assign(rows.size(), 0.0f);
+    for (int sweep = 0; sweep < kDualSweeps && !rows.empty(); ++sweep) {
+      float change = 0.0f;
+      for (size_t k = 0; k < rows.size(); ++k) {
+        float az = 0.0f;
+        for (int v = 0; v < 6; ++v) az += rows[k][v] * z[v];
+        const float l = std::max(0.0f, lambda[k] + (b[k] - az) / norm2[k]);
+        const float d = l - lambda[k];
+        if (d == 0.0f) continue;
+        lambda[k] = l;
+        for (int v = 0; v < 6; ++v) z[v] += d * rows[k][v];
+        change = std::max(change, std::abs(d));
+      }
+      if (change < 1e-8f) break;
+    }
+    const glm::vec3 t(z[0], z[1], z[2]), w = glm::vec3(z[3], z[4], z[5]) / kLever;
+    // No step may carry a part farther than its distance to any surface not in the active set
+    // (it could be a thin plate the linearisation cannot see), nor a constrained one by more
+    // than its band.
+    float s = 1.0f;
+    for (size_t i = 0; i < n; ++i) {
+      const float motion = glm::length(t) + glm::length(w) * glm::length(world[i] - pivot);
+      if (motion < 1e-9f) continue;
+      const float room = clearance[i] < o.margin + kActiveBand
+                             ? kActiveBand
+                             : std::max(clearance[i] - o.margin, 0.0f);
+      s = std::min(s, room / motion);
+    }
+    // The linearisation errs by the surfaces' curvature: halve until nothing ends inside.
+    Pose next = pose;
+    bool accepted = false;
+    for (int halving = 0; halving < 6 && s > 1e-4f; ++halving, s *= 0.5f) {
+      next = moved(pose, pivot, t * s, w * s);
+      std::vector<glm::vec3> check(n);
+      for (size_t i = 0; i < n; ++i) check[i] = next.transformPoint(parts.local[i]);
+      std::vector<float> c2;
+      std::vector<glm::vec3> g2;
+      if (probe(check, parts.radius, o.margin + kActiveBand, c2, g2) >= 0.0f) {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) break;
+    const float step =
+        glm::length(next.position - pose.position) +
+        kLever * glm::length(rotationVector(next.orientation * glm::conjugate(pose.orientation)));
+    pose = next;
+    if (step < 1e-6f) break;
+  }
+  samples += probe.samples;
+  return pose;
+}
+
+}  // namespace
+
+std::optional<Error> OuterHandOptions::validate() const {
+  if (!(margin >= 0.0f && margin <= 0.01f) || !(releaseDistance > 0.0f) ||
+      !std::isfinite(releaseDistance) || !(blendTime >= 0.0f) || !std::isfinite(blendTime) ||
+      maxIterations < 1 || !(stillness >= 0.0f) || !std::isfinite(stillness))
+    return makeError(Status::invalid_argument,
+                     "outer hand: margin in [0, 0.01], releaseDistance > 0, blendTime >= 0, "
+                     "maxIterations >= 1, stillness >= 0, all finite");
+  return std::nullopt;
+}
+
+OuterHand::OuterHand(const HandModel& model, const OuterHandOptions& options)
+    : model_(model), options_(options) {
+  prepareFingers();
+}
+
+void OuterHand::setModel(const HandModel& model) {
+  model_ = model;
+  prepareFingers();
+}
+
+void OuterHand::reset() {
+  engaged_ = false;
+  released_ = false;
+  blending_ = false;
+  capped_.fill(false);
+}
+
+void OuterHand::prepareFingers() {
+  for (int f = 0; f < kFingerCount; ++f) {
+    const Finger finger = Finger(f);
+    const std::span<const Joint> joints = fingerJoints(finger);
+    const int bones = int(joints.size()) - 1;
+    std::array<Pose, 5> open{}, closed{};
+    model_.fingerPose(finger, 0.0f, std::span(open.data(), joints.size()));
+    model_.fingerPose(finger, 1.0f, std::span(closed.data(), joints.size()));
+    // The first bone that moves with the curl (the thumb's metacarpal turns, the others' not).
+    const int first = glm::length(open[1].position - closed[1].position) > 1e-6f ? 0 : 1;
+    FingerRig& rig = rigs_[size_t(f)];
+    rig = FingerRig{};
+    for (int bone = first; bone < bones; ++bone) {
+      const float r0 = model_.jointRadius(joints[size_t(bone)]);
+      const float r1 = model_.jointRadius(joints[size_t(bone) + 1]);
+      const float rmin = std::max(1e-4f, std::min(r0, r1));
+      const float length =
+          glm::length(open[size_t(bone) + 1].position - open[size_t(bone)].position);
+      const int count = std::max(1, int(std::ceil(length / (kFingerSpacing * rmin))));
+      const float spacing = length / float(count);
+      const float grow = std::sqrt(rmin * rmin + 0.25f * spacing * spacing) - rmin;
+      for (int k = 1; k <= count; ++k) {
+        const float u = float(k) / float(count);
+        rig.t.push_back(float(bone) + u);
+        rig.radius.push_back((1.0f - u) * r0 + u * r1 + grow);
+      }
+    }
+    // A bound on every sphere's motion per unit curl, from the model itself (finite differences,
+    // with a margin for the curvature between samples).
+    std::vector<glm::vec3> a, c;
+    constexpr int kProbe = 64;
+    for (int k = 0; k < kProbe; ++k) {
+      fingerSpheres(f, float(k) / kProbe, a);
+      fingerSpheres(f, float(k + 1) / kProbe, c);
+      for (size_t i = 0; i < a.size(); ++i)
+        rig.speed = std::max(rig.speed, glm::length(c[i] - a[i]) * float(kProbe));
+    }
+    rig.speed = rig.speed * 1.1f + 1e-4f;
+  }
+}
+
+void OuterHand::fingerSpheres(int f, float a, std::vector<glm::vec3>& out) const {
+  const Finger finger = Finger(f);
+  const std::span<const Joint> joints = fingerJoints(finger);
+  std::array<Pose, 5> poses{};
+  model_.fingerPose(finger, a, std::span(poses.data(), joints.size()));
+  const FingerRig& rig = rigs_[size_t(f)];
+  out.resize(rig.t.size());
+  for (size_t i = 0; i < rig.t.size(); ++i) {
+    const int bone = std::min(int(rig.t[i]), int(joints.size()) - 2);
+    const float u = rig.t[i] - float(bone);
+    out[i] = glm::mix(poses[size_t(bone)].position, poses[size_t(bone) + 1].position, u);
+  }
+}
+
+Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
+                                          const ExactDistanceSource* scene) {
+  if (in.joints == nullptr || in.radii == nullptr || !finitePose(in.worldFromWrist))
+    return makeError(Status::invalid_argument, "outer hand: joints, radii and a finite wrist");
+  if (auto e = options_.validate()) return *e;
+  const Pose& tracked = in.worldFromWrist;
+  OuterHandResult out;
+  out.worldFromShownWrist = tracked;
+  out.clearance = kInf;
+  if (scene == nullptr) {
+    reset();
+    return out;
+  }
+
+  // The hand as given, in parts (wrist frame): the rigid ones, and each finger's.
+  HandParts parts;
+  const int count = jointParts(*in.joints, *in.radii, parts);
+  RigidParts rigid;
+  std::array<std::vector<glm::vec3>, kFingerCount> fingerLocal;
+  std::array<std::vector<float>, kFingerCount> fingerRadius;
+  for (int i = 0; i < count; ++i) {
+    const HandPart& p = parts[size_t(i)];
+    const int f = fingerOf(p.joint);
+    if (f < 0 || isMetacarpal(p.joint)) {
+      rigid.local.push_back(p.centre);
+      rigid.radius.push_back(p.coverRadius);
+    } else {
+      fingerLocal[size_t(f)].push_back(p.centre);
+      fingerRadius[size_t(f)].push_back(p.coverRadius);
+    }
+  }
+  for (const HandPart& p : in.attached) {
+    rigid.local.push_back(p.centre);
+    rigid.radius.push_back(p.coverRadius);
+  }
+  const glm::vec3 pivot = (*in.joints)[size_t(Joint::palm)].position;
+  const FingerCurls user = model_.estimateCurls(*in.joints);
+
+  if (!engaged_) {
+    engaged_ = true;
+    shown_ = tracked;
+    lastTracked_ = tracked;
+    for (int f = 0; f < kFingerCount; ++f) curl_[size_t(f)] = user[size_t(f)];
+    capped_.fill(false);
+  }
+
+  // The largest motion of any part between two wrist poses.
+  auto motion = [&](const Pose& a, const Pose& b) {
+    float m = 0.0f;
+    for (int i = 0; i < count; ++i) {
+      const glm::vec3 p = parts[size_t(i)].centre;
+      m = std::max(m, glm::length(a.transformPoint(p) - b.transformPoint(p)));
+    }
+    return m;
+  };
+  Probe probe(*scene);
+  std::vector<glm::vec3> world, gradient;
+  std::vector<float> clearance, radii;
+  // The whole hand as given, placed at `wrist`: its smallest clearance (searched within reach).
+  auto handClearance = [&](const Pose& wrist, float reach) {
+    world.clear(), radii.clear();
+    for (int i = 0; i < count; ++i) {
+      world.push_back(wrist.transformPoint(parts[size_t(i)].centre));
+      radii.push_back(parts[size_t(i)].coverRadius);
+    }
+    for (const HandPart& p : in.attached) {
+      world.push_back(wrist.transformPoint(p.centre));
+      radii.push_back(p.coverRadius);
+    }
+    return probe(world, radii, reach, clearance, gradient);
+  };
+
+  // Returning to tracking: blend, then follow tracking until the tracked hand is clear.
+  if (blending_ || released_) {
+    if (blending_) {
+      const float alpha =
+          options_.blendTime > 0.0f
+              ? float(std::clamp((in.time - blendStart_) / options_.blendTime, 0.0, 1.0))
+              : 1.0f;
+      shown_ = Pose{glm::slerp(blendFrom_.orientation, tracked.orientation, alpha),
+                    glm::mix(blendFrom_.position, tracked.position, alpha)};
+      if (alpha >= 1.0f) blending_ = false, released_ = true, shown_ = tracked;
+    } else {
+      shown_ = tracked;
+    }
+    // A bounded search that finds nothing says "clear" about a part deep inside too: search as far
+    // as a hand let go can be inside, so that only a hand really out re-engages.
+    if (released_ && handClearance(tracked, kReleasedReach) >= options_.margin) {
+      released_ = false;  // the tracked hand came out: the outer hand holds again
+    }
+    out.worldFromShownWrist = shown_;
+    out.offset = tracked.inverse() * shown_;
+    out.blending = blending_;
+    out.released = released_;
+    out.constrained = blending_;
+    out.samples = probe.samples;
+    lastTracked_ = tracked;
+    capped_.fill(false);
+    return out;
+  }
+
+  // Too far from tracking: let go, blended.
+  if (motion(shown_, tracked) > options_.releaseDistance) {
+    blending_ = true;
+    blendStart_ = in.time;
+    blendFrom_ = shown_;
+    out.worldFromShownWrist = shown_;
+    out.offset = tracked.inverse() * shown_;
+    out.blending = true;
+    out.constrained = true;
+    lastTracked_ = tracked;
+    return out;
+  }
+
+  // Nothing within the motion from the last shown pose to the tracked one, fingers as given:
+  // the tracked hand, exactly.
+  const float reach = motion(shown_, tracked);
+  const bool wasConstrained = motion(shown_, lastTracked_) > 1e-7f ||
+                              std::any_of(capped_.begin(), capped_.end(), [](bool c) { return c; });
+  if (handClearance(shown_, reach + options_.margin + kActiveBand) > reach + options_.margin &&
+      (!wasConstrained ||
+       handClearance(tracked, options_.margin + kActiveBand) >= options_.margin)) {
+    shown_ = tracked;
+    lastTracked_ = tracked;
+    capped_.fill(false);
+    for (int f = 0; f < kFingerCount; ++f) curl_[size_t(f)] = user[size_t(f)];
+    out.samples = probe.samples;
+    out.clearance =
+        clearance.empty() ? kInf : *std::min_element(clearance.begin(), clearance.end());
+    return out;
+  }
+
+  // A hand held still against a surface stays where it is shown (no jitter).
+  int samples = probe.samples;
+  Pose next = shown_;
+  if (!(wasConstrained && motion(tracked, lastTracked_) <= options_.stillness)) {
+    // The rigid part, with every finger as it was shown (clear there) joining the constraints.
+    RigidParts all = rigid;
+    std::vector<glm::vec3> spheres;
+    for (int f = 0; f < kFingerCount; ++f) {
+      if (capped_[size_t(f)]) {
+        fingerSpheres(f, curl_[size_t(f)], spheres);
+        all.local.insert(all.local.end(), spheres.begin(), spheres.end());
+        all.radius.insert(all.radius.end(), rigs_[size_t(f)].radius.begin(),
+                          rigs_[size_t(f)].radius.end());
+      } else {
+        all.local.insert(all.local.end(), fingerLocal[size_t(f)].begin(),
+                         fingerLocal[size_t(f)].end());
+        all.radius.insert(all.radius.end(), fingerRadius[size_t(f)].begin(),
+                          fingerRadius[size_t(f)].end());
+      }
+    }
+    // Parts already inside where the hand starts cannot constrain a motion: a finger pushed in
+    // by the last frame's fingers is the finger stage's to take out.
+    world.clear();
+    for (const glm::vec3& p : all.local) world.push_back(shown_.transformPoint(p));
+    probe(world, all.radius, options_.margin + kActiveBand, clearance, gradient);
+    RigidParts clear;
+    for (size_t i = 0; i < all.local.size(); ++i) {
+      if (clearance[i] >= 0.0f) {
+        clear.local.push_back(all.local[i]);
+        clear.radius.push_back(all.radius[i]);
+      }
+    }
+    next = slide(clear, pivot, shown_, tracked, *scene, options_, samples);
+  }
+  samples += probe.samples;
+
+  // Each finger from its last shown curl toward the user's, stopping at contact.
+  std::vector<glm::vec3> spheres, sphereWorld;
+  Probe fingerProbe(*scene);
+  for (int f = 0; f < kFingerCount; ++f) {
+    const FingerRig& rig = rigs_[size_t(f)];
+    const float target = user[size_t(f)];
+    float a = curl_[size_t(f)];
+    auto clearanceAt = [&](float curl, float within) {
+      fingerSpheres(f, curl, spheres);
+      sphereWorld.resize(spheres.size());
+      for (size_t i = 0; i < spheres.size(); ++i) sphereWorld[i] = next.transformPoint(spheres[i]);
+      fingerProbe.resetHints();
+      return fingerProbe(sphereWorld, rig.radius, within, clearance, gradient);
+    };
+    bool contact = false;
+    float g = clearanceAt(a, rig.speed * std::abs(target - a) + options_.margin + kActiveBand);
+    // Inside where it starts (the scene moved, or the rigid part could not take it along):
+    // open it until it is clear, or as far as it goes.
+    for (int k = 0; k < kMaxFingerSteps && g < options_.margin && a > 0.0f; ++k) {
+      a = std::max(0.0f, a - std::max(options_.margin - g, 0.0005f) / rig.speed);
+      g = clearanceAt(a, options_.margin + kActiveBand);
+      contact = true;
+    }
+    const float dir = target >= a ? 1.0f : -1.0f;
+    for (int k = 0; k < kMaxFingerSteps && !contact; ++k) {
+      if (g <= options_.margin + kContactTolerance && !(g < options_.margin && a == 0.0f)) {
+        contact = std::abs(target - a) > 1e-6f;
+        break;
+      }
+      if (std::abs(target - a) < 1e-6f) break;
+      const float step = std::max((g - options_.margin) / rig.speed, kMinCurlStep);
+      a = dir > 0.0f ? std::min(target, a + step) : std::max(target, a - step);
+      g = clearanceAt(a, rig.speed * std::abs(target - a) + options_.margin + kActiveBand);
+    }
+    curl_[size_t(f)] = a;
+    // Reached the user's curl and the finger as given is clear too: shown as given.
+    bool asGiven = !contact && std::abs(target - a) < 1e-6f;
+    if (asGiven && !fingerLocal[size_t(f)].empty()) {
+      sphereWorld.resize(fingerLocal[size_t(f)].size());
+      for (size_t i = 0; i < sphereWorld.size(); ++i)
+        sphereWorld[i] = next.transformPoint(fingerLocal[size_t(f)][i]);
+      asGiven = fingerProbe(sphereWorld, fingerRadius[size_t(f)], options_.margin + kActiveBand,
+                            clearance, gradient) >= options_.margin;
+    }
+    capped_[size_t(f)] = !asGiven;
+  }
+  samples += fingerProbe.samples;
+
+  shown_ = next;
+  lastTracked_ = tracked;
+  out.worldFromShownWrist = shown_;
+  out.offset = tracked.inverse() * shown_;
+  out.capped = capped_;
+  out.curl = curl_;
+  out.constrained = motion(shown_, tracked) > 1e-7f ||
+                    std::any_of(capped_.begin(), capped_.end(), [](bool c) { return c; });
+  out.clearance = handClearance(shown_, options_.margin + kActiveBand);
+  out.touching = out.clearance <= options_.margin + 0.0005f;
+  out.samples = samples + probe.samples;
+  return out;
+}
+
+}  // namespace sdfg

@@ -1,0 +1,115 @@
+// The outer hand: the hand the user sees stays outside every registered object in every frame,
+// not only at a grab (issue 27). When the tracked hand enters an object, the shown hand stops on
+// its surface and slides along it; when it comes out, the shown hand is the tracked hand again.
+//
+// It is a god-object (a proxy with history, as in haptic rendering): each frame the shown hand
+// moves from where it was shown last toward the tracked hand, and never through a surface.
+// - Rigid part (palm, metacarpals, a held object): from the last shown wrist pose toward the
+//   tracked one, by steps no longer than the distance to the nearest unseen surface (so at any
+//   speed it cannot cross a thin plate), each step the motion nearest the tracked pose that keeps
+//   every part clear on the linearised exact distances (a small quadratic programme, translation
+//   and a turn about the palm). A hand pushed through a thin plate stays on the side it came from.
+// - Fingers: each finger's curl (the hand model's curl space) moves from the last shown curl
+//   toward the user's, and stops at contact: a finger pressed onto a surface stops on it, and is
+//   shown at the model's pose at that curl; a finger that touches nothing is shown as given.
+// - Release: when the tracked hand is more than releaseDistance from the shown one (largest part
+//   motion), the shown hand returns to tracking, blended over blendTime, as the Ultraleap and
+//   SteamVR hands do; it re-engages once the tracked hand is clear again.
+// - While the straight motion from the last shown pose to the tracked one is free by more than the
+//   motion itself (nothing near), the shown hand is the tracked hand, exactly.
+//
+// Distances come from an ExactDistanceSource in world space (a SceneExactSource whose members'
+// objectFromHand map world points). Pure CPU work with bounded exact searches: the session's
+// worker runs it, never the app's thread.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "base/pose.h"
+#include "grasp/hand_clearance.h"
+#include "grasp/solver.h"
+#include "hand/hand_model.h"
+
+namespace sdfg {
+
+struct OuterHandOptions {
+  float margin = 0.0005f;         // clearance every part keeps, metres
+  float releaseDistance = 0.10f;  // metres of largest part motion between shown and tracked
+  float blendTime = 0.25f;        // seconds of the return to tracking past releaseDistance
+  int maxIterations = 12;         // sliding steps per frame
+  // The shown hand does not move while the tracked hand moves less than this (largest part
+  // motion, metres) since the last frame and the shown one is constrained: no jitter on a hand
+  // held still against a surface.
+  float stillness = 0.00005f;
+  std::optional<Error> validate() const;
+};
+
+// One frame of the hand as the app would show it without the outer hand.
+struct OuterHandInput {
+  Pose worldFromWrist;  // the tracked (or synthesized) wrist joint, world space
+  // The 26 joints in the wrist's frame and their radii, as they would be shown.
+  const JointPoses* joints = nullptr;
+  const std::array<float, kJointCount>* radii = nullptr;
+  double time = 0.0;  // seconds, any origin (the blend's clock)
+  // Parts of a held object, wrist frame: part of the hand, kept out of everything else (the
+  // caller leaves the held object itself out of `scene`).
+  std::span<const HandPart> attached{};
+};
+
+struct OuterHandResult {
+  Pose worldFromShownWrist;  // where the wrist is shown
+  Pose offset;               // the shown wrist in the tracked wrist's frame (identity: tracked)
+  // Per finger: shown at the model's pose at curl[f] (true), or as given (false).
+  std::array<bool, kFingerCount> capped{};
+  std::array<float, kFingerCount> curl{};
+  bool constrained = false;  // the shown hand differs from the input
+  bool touching = false;     // some part is on a surface (within margin + 0.5 mm)
+  bool blending = false;     // returning to tracking past releaseDistance
+  bool released = false;     // following tracking until the tracked hand is clear again
+  float clearance = 0.0f;    // smallest part clearance of the shown hand, metres (inf: nothing)
+  int samples = 0;           // exact samples taken this frame
+};
+
+class OuterHand {
+ public:
+  explicit OuterHand(const HandModel& model, const OuterHandOptions& options = {});
+
+  // One frame. `scene` is everything the hand stays out of (null: nothing near; the shown hand is
+  // the input and the history is dropped). Fails only on invalid input (joints or radii null,
+  // non-finite poses).
+  Result<OuterHandResult> update(const OuterHandInput& in, const ExactDistanceSource* scene);
+  void reset();
+  // The hand model whose curls the capped fingers use (fitted to a tracked hand by the caller).
+  void setModel(const HandModel& model);
+  const HandModel& model() const { return model_; }
+
+ private:
+  struct FingerRig {
+    std::vector<float> t;  // spheres along the finger's moving bones: bone index + fraction
+    std::vector<float> radius;
+    float speed = 0.0f;  // bound on any sphere's motion per unit curl, metres
+  };
+  void prepareFingers();
+  // The sphere centres of finger f at curl a (wrist frame).
+  void fingerSpheres(int f, float a, std::vector<glm::vec3>& out) const;
+
+  HandModel model_;
+  OuterHandOptions options_;
+  std::array<FingerRig, kFingerCount> rigs_{};
+
+  bool engaged_ = false;  // history exists
+  Pose shown_;            // last shown wrist, world
+  Pose lastTracked_;
+  std::array<bool, kFingerCount> capped_{};
+  std::array<float, kFingerCount> curl_{};  // last shown curl per finger
+  bool released_ = false;
+  bool blending_ = false;
+  double blendStart_ = 0.0;
+  Pose blendFrom_;
+};
+
+}  // namespace sdfg

@@ -1,0 +1,241 @@
+// The outer hand (grasp/outer_hand.h) on analytic scenes with known answers: a table top, a thin
+// plate, a box beside the hand.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "grasp/outer_hand.h"
+#include "grasp/scene_exact_source.h"
+#include "scene/analytic_shape.h"
+
+using namespace sdfg;
+
+namespace {
+
+constexpr double kFrame = 1.0 / 90.0;
+
+struct TestHand {
+  HandModel model = HandModel::defaultAdult(sdfg::Hand::right);
+  JointPoses joints{};
+  std::array<float, kJointCount> radii{};
+  explicit TestHand(float curl = 0.0f) { setCurl(curl); }
+  void setCurl(float curl) {
+    FingerCurls c;
+    c.fill(curl);
+    model.pose(c, joints);
+    for (int j = 0; j < kJointCount; ++j) radii[size_t(j)] = model.jointRadius(Joint(j));
+  }
+  // The lowest point of the hand's surface, wrist frame y (the palm faces -Y when the wrist's
+  // orientation is the identity).
+  float lowest() const {
+    HandParts parts;
+    const int n = jointParts(joints, radii, parts);
+    float y = std::numeric_limits<float>::infinity();
+    for (int i = 0; i < n; ++i)
+      y = std::min(y, parts[size_t(i)].centre.y - parts[size_t(i)].radius);
+    return y;
+  }
+};
+
+Pose at(const glm::vec3& p) {
+  return Pose{glm::quat(1, 0, 0, 0), p};
+}
+
+// The smallest clearance of the hand as shown (capped fingers at the model's curl), world frame.
+float shownClearance(const TestHand& h, const OuterHandResult& r, const AnalyticShape& shape,
+                     const Pose& worldFromShape) {
+  JointPoses shown = h.joints;
+  for (int f = 0; f < kFingerCount; ++f) {
+    if (!r.capped[size_t(f)]) continue;
+    const std::span<const Joint> fj = fingerJoints(Finger(f));
+    std::array<Pose, 5> poses{};
+    h.model.fingerPose(Finger(f), r.curl[size_t(f)], std::span(poses.data(), fj.size()));
+    for (size_t k = 0; k < fj.size(); ++k) shown[size_t(fj[k])] = poses[k];
+  }
+  HandParts parts;
+  const int n = jointParts(shown, h.radii, parts);
+  float lowest = std::numeric_limits<float>::infinity();
+  const Pose shapeFromWorld = worldFromShape.inverse();
+  for (int i = 0; i < n; ++i) {
+    const glm::vec3 p = shapeFromWorld.transformPoint(
+        r.worldFromShownWrist.transformPoint(parts[size_t(i)].centre));
+    lowest = std::min(lowest, shape.signedDistance(p) - parts[size_t(i)].radius);
+  }
+  return lowest;
+}
+
+}  // namespace
+
+TEST_CASE("The outer hand is the tracked hand while nothing is near", "[core][outer_hand]") {
+  TestHand h;
+  const AnalyticShape table{ShapeKind::box, glm::vec3(0.5f, 0.02f, 0.5f)};
+  const std::vector<SceneMember> members{{1, nullptr, &table, at(glm::vec3(0.0f, 0.02f, 0.0f))}};
+  const SceneExactSource scene(members);
+  OuterHand outer(h.model);
+  for (int frame = 0; frame < 30; ++frame) {
+    OuterHandInput in;
+    in.worldFromWrist = at(glm::vec3(0.01f * float(frame), 0.3f, 0.0f));
+    in.joints = &h.joints;
+    in.radii = &h.radii;
+    in.time = frame * kFrame;
+    const auto r = outer.update(in, &scene);
+    REQUIRE(r.ok());
+    CHECK_FALSE(r->constrained);
+    CHECK(r->worldFromShownWrist.position == in.worldFromWrist.position);
+    CHECK(r->worldFromShownWrist.orientation == in.worldFromWrist.orientation);
+    CHECK(r->offset.position == glm::vec3(0.0f));
+  }
+}
+
+TEST_CASE("A hand pushed into a table stops on it, slides along it and comes back out",
+          "[core][outer_hand]") {
+  TestHand h;
+  const AnalyticShape table{ShapeKind::box, glm::vec3(0.5f, 0.02f, 0.5f)};
+  const Pose worldFromTable = at(glm::vec3(0.0f, -0.02f, 0.0f));  // its top at y = 0
+  const std::vector<SceneMember> members{{1, nullptr, &table, worldFromTable.inverse()}};
+  const SceneExactSource scene(members);
+  OuterHand outer(h.model);
+  const float touchHeight = -h.lowest();  // wrist height at which the hand just touches y = 0
+  float deepest = 0.0f, worstJitter = 0.0f;
+  Pose last;
+  double t = 0.0;
+  auto step = [&](const glm::vec3& wrist) {
+    OuterHandInput in;
+    in.worldFromWrist = at(wrist);
+    in.joints = &h.joints;
+    in.radii = &h.radii;
+    in.time = (t += kFrame);
+    const auto r = outer.update(in, &scene);
+    REQUIRE(r.ok());
+    deepest = std::min(deepest, shownClearance(h, *r, table, worldFromTable));
+    return *r;
+  };
+  // Down from 5 cm above the touch to 4 cm below it, 1 cm per frame (0.9 m/s).
+  OuterHandResult r;
+  for (int k = 0; k <= 9; ++k) r = step(glm::vec3(0.0f, touchHeight + 0.05f - 0.01f * k, 0.0f));
+  CHECK(r.constrained);
+  CHECK(r.touching);
+  CHECK(r.worldFromShownWrist.position.y == Approx(touchHeight).margin(0.002f));
+  // Held still inside for 60 frames: no jitter.
+  last = r.worldFromShownWrist;
+  for (int k = 0; k < 60; ++k) {
+    r = step(glm::vec3(0.0f, touchHeight - 0.04f, 0.0f));
+    worstJitter =
+        std::max(worstJitter, glm::length(r.worldFromShownWrist.position - last.position));
+    last = r.worldFromShownWrist;
+  }
+  CHECK(worstJitter <= 0.0001f);
+  // Slides 5 cm along x while 4 cm inside: the shown hand follows along the surface.
+  for (int k = 1; k <= 10; ++k) r = step(glm::vec3(0.005f * k, touchHeight - 0.04f, 0.0f));
+  CHECK(r.worldFromShownWrist.position.x == Approx(0.05f).margin(0.003f));
+  CHECK(r.worldFromShownWrist.position.y == Approx(touchHeight).margin(0.002f));
+  CHECK(deepest >= -0.001f);
+  // Out again: the tracked hand, exactly.
+  for (int k = 0; k <= 10; ++k) r = step(glm::vec3(0.05f, touchHeight - 0.04f + 0.01f * k, 0.0f));
+  CHECK_FALSE(r.constrained);
+  CHECK(r.worldFromShownWrist.position == glm::vec3(0.05f, touchHeight - 0.04f + 0.1f, 0.0f));
+}
+
+TEST_CASE("A hand swiped at 2 m/s through a 3 mm plate stays on its side", "[core][outer_hand]") {
+  TestHand h;
+  // A vertical plate 3 mm thick in x, the hand moving along +x (palm down, the side of the hand
+  // leading).
+  const AnalyticShape plate{ShapeKind::box, glm::vec3(0.0015f, 0.3f, 0.3f)};
+  const Pose worldFromPlate = at(glm::vec3(0.0f));
+  const std::vector<SceneMember> members{{1, nullptr, &plate, worldFromPlate.inverse()}};
+  const SceneExactSource scene(members);
+  OuterHandOptions o;
+  o.releaseDistance = 1.0f;  // this test is about not passing, not about the release
+  OuterHand outer(h.model, o);
+  float deepest = 0.0f, farthestX = -1.0f;
+  for (int k = 0; k < 30; ++k) {
+    OuterHandInput in;
+    // 2 m/s: 22 mm per frame, from 20 cm before the plate to 45 cm past it.
+    in.worldFromWrist = at(glm::vec3(-0.2f + 0.0222f * k, 0.0f, 0.0f));
+    in.joints = &h.joints;
+    in.radii = &h.radii;
+    in.time = k * kFrame;
+    const auto r = outer.update(in, &scene);
+    REQUIRE(r.ok());
+    deepest = std::min(deepest, shownClearance(h, *r, plate, worldFromPlate));
+    farthestX = std::max(farthestX, r->worldFromShownWrist.position.x);
+  }
+  CHECK(deepest >= -0.001f);
+  // The wrist never reaches the plate's far side: the hand stays before it.
+  CHECK(farthestX < 0.0f);
+}
+
+TEST_CASE("A finger pressed onto a surface stops on it", "[core][outer_hand]") {
+  TestHand open;
+  const AnalyticShape table{ShapeKind::box, glm::vec3(0.5f, 0.02f, 0.5f)};
+  const float touch = -open.lowest();
+  // The open hand 1 cm above the touch; the table's top at y = 0.
+  const Pose worldFromTable = at(glm::vec3(0.0f, -0.02f, 0.0f));
+  const std::vector<SceneMember> members{{1, nullptr, &table, worldFromTable.inverse()}};
+  const SceneExactSource scene(members);
+  OuterHand outer(open.model);
+  OuterHandResult r;
+  for (int k = 0; k <= 20; ++k) {
+    TestHand h(0.05f * k);  // curling to fully closed over 20 frames
+    OuterHandInput in;
+    in.worldFromWrist = at(glm::vec3(0.0f, touch + 0.01f, 0.0f));
+    in.joints = &h.joints;
+    in.radii = &h.radii;
+    in.time = k * kFrame;
+    const auto got = outer.update(in, &scene);
+    REQUIRE(got.ok());
+    r = *got;
+    CHECK(shownClearance(h, r, table, worldFromTable) >= -0.001f);
+  }
+  // The hand does not move up: its fingers stop on the table instead.
+  CHECK(r.worldFromShownWrist.position.y == Approx(touch + 0.01f).margin(1e-5f));
+  int stopped = 0;
+  for (int f = 1; f < kFingerCount; ++f)
+    stopped += r.capped[size_t(f)] && r.curl[size_t(f)] < 0.99f;
+  CHECK(stopped >= 3);
+}
+
+TEST_CASE("Past the release distance the shown hand returns to tracking, blended",
+          "[core][outer_hand]") {
+  TestHand h;
+  const AnalyticShape table{ShapeKind::box, glm::vec3(0.5f, 0.1f, 0.5f)};
+  const Pose worldFromTable = at(glm::vec3(0.0f, -0.1f, 0.0f));
+  const std::vector<SceneMember> members{{1, nullptr, &table, worldFromTable.inverse()}};
+  const SceneExactSource scene(members);
+  OuterHand outer(h.model);
+  const float touch = -h.lowest();
+  bool blended = false, released = false;
+  OuterHandResult r;
+  double t = 0.0;
+  for (int k = 0; k < 60; ++k) {
+    OuterHandInput in;
+    // Down 1 cm per frame, to 15 cm below the touch.
+    in.worldFromWrist = at(glm::vec3(0.0f, touch + 0.02f - 0.01f * std::min(k, 17), 0.0f));
+    in.joints = &h.joints;
+    in.radii = &h.radii;
+    in.time = (t += kFrame);
+    r = *outer.update(in, &scene);
+    blended = blended || r.blending;
+    released = released || r.released;
+  }
+  CHECK(blended);
+  CHECK(released);
+  // Following the tracked hand inside, until it comes out.
+  CHECK(r.worldFromShownWrist.position.y == Approx(touch - 0.15f).margin(1e-5f));
+  for (int k = 0; k < 30; ++k) {
+    OuterHandInput in;
+    in.worldFromWrist = at(glm::vec3(0.0f, touch - 0.15f + 0.01f * k, 0.0f));
+    in.joints = &h.joints;
+    in.radii = &h.radii;
+    in.time = (t += kFrame);
+    r = *outer.update(in, &scene);
+  }
+  CHECK_FALSE(r.released);
+  CHECK_FALSE(r.constrained);
+}

@@ -20,6 +20,8 @@ constexpr float kLever = 0.1f;  // metres
 constexpr int kDualSweeps = 100;
 constexpr int kMaxFingerSteps = 64;
 constexpr float kMinCurlStep = 1e-4f;
+// Finger spheres whose clearance bound is this far above a contact are not searched again.
+constexpr float kFingerSlack = 0.003f;  // metres
 // Spheres along a finger's bones are at most this many of the smaller joint radius apart.
 constexpr float kFingerSpacing = 0.7f;
 // How far the check for a released hand's coming out searches (a hand let go can be deep inside).
@@ -63,33 +65,52 @@ Pose moved(const Pose& pose, const glm::vec3& pivot, const glm::vec3& t, const g
   return Pose{glm::normalize(r * pose.orientation), r * (pose.position - pivot) + pivot + t};
 }
 
-// Exact clearances of a set of spheres (world centres, radii to keep clear), one batch.
+// Exact clearances of spheres (world centres, radii to keep clear). Keeps, per sphere, a lower
+// bound of its clearance: the exact distance changes by at most the centre's motion, so a sphere
+// whose bound stays above what a caller asks about is not searched again (most of a hand is far
+// from any surface while a few parts touch).
 class Probe {
  public:
   explicit Probe(const ExactDistanceSource& source) : source_(source) {}
 
-  // For each sphere: clearance (distance - radius; `reach - radius` when nothing is within
-  // `reach` of its centre and it is not known to be inside) and the unit gradient of the
-  // distance (zero when nothing was found). Returns the smallest clearance.
+  // Sizes the tables for `n` spheres and forgets every bound.
+  void reset(size_t n) {
+    bound.assign(n, -kInf);
+    clearance.assign(n, kInf);
+    gradient.assign(n, glm::vec3(0.0f));
+    fresh.assign(n, 0);
+    hints_.assign(n, std::numeric_limits<uint32_t>::max());
+  }
+  // Every bound drops by the motion of its sphere (moves[i], metres).
+  void moved(std::span<const float> motions) {
+    for (size_t i = 0; i < bound.size(); ++i) bound[i] -= motions[i], fresh[i] = 0;
+  }
+  // Searches, within `reach` beyond its radius, every sphere whose bound is below `below`; sets
+  // its clearance (distance - radius, or `reach` when nothing is that close and it is not known
+  // to be inside), gradient (unit, zero when nothing was found) and bound. Returns the smallest
+  // bound over all spheres.
   float operator()(std::span<const glm::vec3> centres, std::span<const float> radii, float reach,
-                   std::vector<float>& clearance, std::vector<glm::vec3>& gradient) {
-    const size_t n = centres.size();
-    bounds_.assign(n, 0.0f);
-    for (size_t i = 0; i < n; ++i) bounds_[i] = radii[i] + reach;
-    found_.resize(n);
-    if (hints_.size() != n) hints_.assign(n, std::numeric_limits<uint32_t>::max());
-    for (size_t i = 0; i < n; ++i) found_[i].feature = hints_[i];
-    source_.sample(centres, bounds_, found_);
-    samples += int(n);
-    clearance.resize(n);
-    gradient.resize(n);
-    float lowest = kInf;
-    for (size_t i = 0; i < n; ++i) {
-      const ExactSample& s = found_[i];
+                   float below) {
+    asked_.clear(), points_.clear(), bounds_.clear(), found_.clear();
+    for (size_t i = 0; i < centres.size(); ++i) {
+      if (bound[i] >= below) continue;
+      asked_.push_back(i);
+      points_.push_back(centres[i]);
+      bounds_.push_back(radii[i] + reach);
+      ExactSample s;
+      s.feature = hints_[i];
+      found_.push_back(s);
+    }
+    if (!asked_.empty()) source_.sample(points_, bounds_, found_);
+    samples += int(asked_.size());
+    for (size_t k = 0; k < asked_.size(); ++k) {
+      const size_t i = asked_[k];
+      const ExactSample& s = found_[k];
       hints_[i] = s.feature;
       gradient[i] = glm::vec3(0.0f);
+      fresh[i] = 1;
       if (!std::isfinite(s.distance)) {
-        clearance[i] = bounds_[i] - radii[i];
+        clearance[i] = reach;
       } else {
         clearance[i] = s.distance - radii[i];
         if (std::abs(s.distance) > 1e-7f) {
@@ -98,15 +119,23 @@ class Probe {
           if (gl > 1e-3f) gradient[i] = g / gl;
         }
       }
-      lowest = std::min(lowest, clearance[i]);
+      bound[i] = clearance[i];
     }
+    float lowest = kInf;
+    for (float b : bound) lowest = std::min(lowest, b);
     return lowest;
   }
-  void resetHints() { hints_.clear(); }
+
+  std::vector<float> bound;         // lower bound of each sphere's clearance, metres
+  std::vector<float> clearance;     // its last searched clearance
+  std::vector<glm::vec3> gradient;  // and distance gradient
+  std::vector<char> fresh;          // searched since the last motion
   int samples = 0;
 
  private:
   const ExactDistanceSource& source_;
+  std::vector<size_t> asked_;
+  std::vector<glm::vec3> points_;
   std::vector<float> bounds_;
   std::vector<ExactSample> found_;
   std::vector<uint32_t> hints_;
@@ -124,10 +153,13 @@ Pose slide(const RigidParts& parts, const glm::vec3& pivotLocal, const Pose& fro
   const size_t n = parts.local.size();
   if (n == 0) return goal;
   Probe probe(source);
-  std::vector<glm::vec3> world(n), gradient;
-  std::vector<float> clearance;
+  probe.reset(n);
+  std::vector<glm::vec3> world(n), check(n);
+  std::vector<float> motion(n);
   std::vector<std::array<float, 6>> rows;
   std::vector<float> b, lambda, norm2;
+  // Parts this far beyond the active band are left to their bounds.
+  constexpr float kSlack = 0.002f;
   Pose pose = from;
   for (int it = 0; it < o.maxIterations; ++it) {
     const glm::vec3 pivot = pose.transformPoint(pivotLocal);
@@ -140,13 +172,18 @@ Pose slide(const RigidParts& parts, const glm::vec3& pivotLocal, const Pose& fro
       farthest = std::max(farthest,
                           glm::length(tGoal) + glm::length(wGoal) * glm::length(world[i] - pivot));
     }
-    if (farthest < 1e-6f) return goal;
+    if (farthest < 1e-6f) {
+      pose = goal;
+      break;
+    }
+    // The first search reaches as far as the motion; later ones only parts near a surface.
+    const float reach = farthest + o.margin + kActiveBand;
     const float lowest =
-        probe(world, parts.radius, farthest + o.margin + kActiveBand, clearance, gradient);
+        probe(world, parts.radius, reach, it == 0 ? kInf : o.margin + kActiveBand + kSlack);
     // Free all the way (nothing within the motion): the goal itself.
     if (lowest > farthest + o.margin) {
-      samples += probe.samples;
-      return goal;
+      pose = goal;
+      break;
     }
     // The constrained step: z = (t, kLever * w) nearest the goal's, every part within the band
     // kept at the margin on its linearised distance. Dual projected Gauss-Seidel.
@@ -154,15 +191,16 @@ Pose slide(const RigidParts& parts, const glm::vec3& pivotLocal, const Pose& fro
                                      kLever * wGoal.x, kLever * wGoal.y, kLever * wGoal.z};
     rows.clear(), b.clear(), norm2.clear();
     for (size_t i = 0; i < n; ++i) {
-      if (!(clearance[i] < o.margin + kActiveBand) || glm::dot(gradient[i], gradient[i]) < 0.25f)
+      const glm::vec3 g = probe.gradient[i];
+      if (!probe.fresh[i] || !(probe.clearance[i] < o.margin + kActiveBand) ||
+          glm::dot(g, g) < 0.25f)
         continue;
-      const glm::vec3 g = gradient[i];
       const glm::vec3 arm = glm::cross(world[i] - pivot, g) / kLever;
       rows.push_back({g.x, g.y, g.z, arm.x, arm.y, arm.z});
       float aa = 0.0f;
       for (float v : rows.back()) aa += v * v;
       norm2.push_back(aa);
-      b.push_back(o.margin - clearance[i]);
+      b.push_back(o.margin - probe.clearance[i]);
     }
     std::array<float, 6> z = zGoal;
     lambda.assign(rows.size(), 0.0f);
@@ -186,28 +224,35 @@ Pose slide(const RigidParts& parts, const glm::vec3& pivotLocal, const Pose& fro
     // than its band.
     float s = 1.0f;
     for (size_t i = 0; i < n; ++i) {
-      const float motion = glm::length(t) + glm::length(w) * glm::length(world[i] - pivot);
-      if (motion < 1e-9f) continue;
-      const float room = clearance[i] < o.margin + kActiveBand
-                             ? kActiveBand
-                             : std::max(clearance[i] - o.margin, 0.0f);
-      s = std::min(s, room / motion);
+      motion[i] = glm::length(t) + glm::length(w) * glm::length(world[i] - pivot);
+      if (motion[i] < 1e-9f) continue;
+      const bool active = probe.fresh[i] && probe.clearance[i] < o.margin + kActiveBand;
+      const float room = active ? kActiveBand : std::max(probe.bound[i] - o.margin, 0.0f);
+      s = std::min(s, room / motion[i]);
     }
-    // The linearisation errs by the surfaces' curvature: halve until nothing ends inside.
-    Pose next = pose;
+    // The linearisation errs by the surfaces' curvature: halve until nothing ends inside. Only
+    // parts whose bound could fall below the margin are searched.
+    Probe verify(source);
     bool accepted = false;
+    Pose next = pose;
     for (int halving = 0; halving < 6 && s > 1e-4f; ++halving, s *= 0.5f) {
       next = moved(pose, pivot, t * s, w * s);
-      std::vector<glm::vec3> check(n);
-      for (size_t i = 0; i < n; ++i) check[i] = next.transformPoint(parts.local[i]);
-      std::vector<float> c2;
-      std::vector<glm::vec3> g2;
-      if (probe(check, parts.radius, o.margin + kActiveBand, c2, g2) >= 0.0f) {
+      verify.reset(n);
+      for (size_t i = 0; i < n; ++i) {
+        check[i] = next.transformPoint(parts.local[i]);
+        verify.bound[i] = probe.bound[i] - motion[i] * s;
+      }
+      const float lowest = verify(check, parts.radius, o.margin + kActiveBand, o.margin + kSlack);
+      samples += verify.samples;
+      verify.samples = 0;
+      if (lowest >= 0.0f) {
         accepted = true;
         break;
       }
     }
     if (!accepted) break;
+    for (size_t i = 0; i < n; ++i) motion[i] *= s;
+    probe.moved(motion);
     const float step =
         glm::length(next.position - pose.position) +
         kLever * glm::length(rotationVector(next.orientation * glm::conjugate(pose.orientation)));
@@ -358,8 +403,8 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
     return m;
   };
   Probe probe(*scene);
-  std::vector<glm::vec3> world, gradient;
-  std::vector<float> clearance, radii;
+  std::vector<glm::vec3> world;
+  std::vector<float> radii;
   // The whole hand as given, placed at `wrist`: its smallest clearance (searched within reach).
   auto handClearance = [&](const Pose& wrist, float reach) {
     world.clear(), radii.clear();
@@ -371,7 +416,8 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
       world.push_back(wrist.transformPoint(p.centre));
       radii.push_back(p.coverRadius);
     }
-    return probe(world, radii, reach, clearance, gradient);
+    probe.reset(world.size());
+    return probe(world, radii, reach, kInf);
   };
 
   // Returning to tracking: blend, then follow tracking until the tracked hand is clear.
@@ -387,10 +433,19 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
     } else {
       shown_ = tracked;
     }
-    // A bounded search that finds nothing says "clear" about a part deep inside too: search as far
-    // as a hand let go can be inside, so that only a hand really out re-engages.
-    if (released_ && handClearance(tracked, kReleasedReach) >= options_.margin) {
-      released_ = false;  // the tracked hand came out: the outer hand holds again
+    // A bounded search that finds nothing says "clear" about a part deep inside too. The palm is
+    // searched as far as a hand let go can be inside; the other parts only near the surface:
+    // with the palm out and no part near a surface, none is inside (the parts of a bone are
+    // closer than their radii, so a chain that crosses the surface puts one near it).
+    if (released_ && handClearance(tracked, options_.margin + kActiveBand) >= options_.margin) {
+      const std::array<glm::vec3, 1> palm{tracked.transformPoint(pivot)};
+      const std::array<float, 1> palmRadius{(*in.radii)[size_t(Joint::palm)]};
+      Probe far(*scene);
+      far.reset(1);
+      if (far(palm, palmRadius, kReleasedReach, kInf) >= options_.margin) {
+        released_ = false;  // the tracked hand came out: the outer hand holds again
+      }
+      probe.samples += far.samples;
     }
     out.worldFromShownWrist = shown_;
     out.offset = tracked.inverse() * shown_;
@@ -430,12 +485,12 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
     for (int f = 0; f < kFingerCount; ++f) curl_[size_t(f)] = user[size_t(f)];
     out.samples = probe.samples;
     out.clearance =
-        clearance.empty() ? kInf : *std::min_element(clearance.begin(), clearance.end());
+        probe.bound.empty() ? kInf : *std::min_element(probe.bound.begin(), probe.bound.end());
     return out;
   }
 
   // A hand held still against a surface stays where it is shown (no jitter).
-  int samples = probe.samples;
+  int slideSamples = 0;
   Pose next = shown_;
   if (!(wasConstrained && motion(tracked, lastTracked_) <= options_.stillness)) {
     // The rigid part, with every finger as it was shown (clear there) joining the constraints.
@@ -458,39 +513,50 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
     // by the last frame's fingers is the finger stage's to take out.
     world.clear();
     for (const glm::vec3& p : all.local) world.push_back(shown_.transformPoint(p));
-    probe(world, all.radius, options_.margin + kActiveBand, clearance, gradient);
+    probe.reset(world.size());
+    probe(world, all.radius, options_.margin + kActiveBand, kInf);
     RigidParts clear;
     for (size_t i = 0; i < all.local.size(); ++i) {
-      if (clearance[i] >= 0.0f) {
+      if (probe.clearance[i] >= 0.0f) {
         clear.local.push_back(all.local[i]);
         clear.radius.push_back(all.radius[i]);
       }
     }
-    next = slide(clear, pivot, shown_, tracked, *scene, options_, samples);
+    next = slide(clear, pivot, shown_, tracked, *scene, options_, slideSamples);
   }
-  samples += probe.samples;
 
   // Each finger from its last shown curl toward the user's, stopping at contact.
   std::vector<glm::vec3> spheres, sphereWorld;
   Probe fingerProbe(*scene);
+  std::vector<float> drop;
   for (int f = 0; f < kFingerCount; ++f) {
     const FingerRig& rig = rigs_[size_t(f)];
     const float target = user[size_t(f)];
     float a = curl_[size_t(f)];
-    auto clearanceAt = [&](float curl, float within) {
+    fingerProbe.reset(rig.t.size());
+    // The finger's smallest clearance at curl `curl`, searching only spheres whose bound is
+    // below `below` (every one at the first call).
+    auto clearanceAt = [&](float curl, float within, float below) {
       fingerSpheres(f, curl, spheres);
       sphereWorld.resize(spheres.size());
       for (size_t i = 0; i < spheres.size(); ++i) sphereWorld[i] = next.transformPoint(spheres[i]);
-      fingerProbe.resetHints();
-      return fingerProbe(sphereWorld, rig.radius, within, clearance, gradient);
+      return fingerProbe(sphereWorld, rig.radius, within, below);
     };
+    auto advance = [&](float from, float to) {
+      drop.assign(rig.t.size(), rig.speed * std::abs(to - from));
+      fingerProbe.moved(drop);
+    };
+    const float near = options_.margin + kContactTolerance + kFingerSlack;
     bool contact = false;
-    float g = clearanceAt(a, rig.speed * std::abs(target - a) + options_.margin + kActiveBand);
+    float g =
+        clearanceAt(a, rig.speed * std::abs(target - a) + options_.margin + kActiveBand, kInf);
     // Inside where it starts (the scene moved, or the rigid part could not take it along):
     // open it until it is clear, or as far as it goes.
     for (int k = 0; k < kMaxFingerSteps && g < options_.margin && a > 0.0f; ++k) {
-      a = std::max(0.0f, a - std::max(options_.margin - g, 0.0005f) / rig.speed);
-      g = clearanceAt(a, options_.margin + kActiveBand);
+      const float b = std::max(0.0f, a - std::max(options_.margin - g, 0.0005f) / rig.speed);
+      advance(a, b);
+      a = b;
+      g = clearanceAt(a, options_.margin + kActiveBand, near);
       contact = true;
     }
     const float dir = target >= a ? 1.0f : -1.0f;
@@ -501,8 +567,10 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
       }
       if (std::abs(target - a) < 1e-6f) break;
       const float step = std::max((g - options_.margin) / rig.speed, kMinCurlStep);
-      a = dir > 0.0f ? std::min(target, a + step) : std::max(target, a - step);
-      g = clearanceAt(a, rig.speed * std::abs(target - a) + options_.margin + kActiveBand);
+      const float b = dir > 0.0f ? std::min(target, a + step) : std::max(target, a - step);
+      advance(a, b);
+      a = b;
+      g = clearanceAt(a, rig.speed * std::abs(target - a) + options_.margin + kActiveBand, near);
     }
     curl_[size_t(f)] = a;
     // Reached the user's curl and the finger as given is clear too: shown as given.
@@ -511,13 +579,12 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
       sphereWorld.resize(fingerLocal[size_t(f)].size());
       for (size_t i = 0; i < sphereWorld.size(); ++i)
         sphereWorld[i] = next.transformPoint(fingerLocal[size_t(f)][i]);
+      fingerProbe.reset(sphereWorld.size());
       asGiven = fingerProbe(sphereWorld, fingerRadius[size_t(f)], options_.margin + kActiveBand,
-                            clearance, gradient) >= options_.margin;
+                            kInf) >= options_.margin;
     }
     capped_[size_t(f)] = !asGiven;
   }
-  samples += fingerProbe.samples;
-
   shown_ = next;
   lastTracked_ = tracked;
   out.worldFromShownWrist = shown_;
@@ -528,7 +595,7 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
                     std::any_of(capped_.begin(), capped_.end(), [](bool c) { return c; });
   out.clearance = handClearance(shown_, options_.margin + kActiveBand);
   out.touching = out.clearance <= options_.margin + 0.0005f;
-  out.samples = samples + probe.samples;
+  out.samples = probe.samples + fingerProbe.samples + slideSamples;
   return out;
 }
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -356,6 +358,57 @@ TEST_CASE("updatePositions gives the distances of a freshly created mesh",
     CHECK(d->updatePositions(collapsed) == Status::invalid_argument);
     CHECK(d->signedDistance(probe) == before);
     CHECK(d->mesh().positions == m.positions);
+  }
+}
+
+TEST_CASE("A stopped set-up or refit says timed_out; a stopped check changes nothing",
+          "[mesh_distance][work_limit]") {
+  std::atomic<bool> stop{true};
+  const WorkLimit stopped{WorkLimit::Clock::time_point::max(), &stop};
+  // Large enough that every step polls (each looks every few thousand elements).
+  const TriangleMesh m = icosphereMesh(0.05f, 5);
+  SECTION("the check") {
+    const auto e = validateMesh(m.positions, m.indices, stopped);
+    REQUIRE(e.has_value());
+    CHECK(e->code == Status::timed_out);
+  }
+  SECTION("the hierarchy alone: an empty tree") {
+    TriangleBvh bvh;
+    CHECK_FALSE(bvh.build(m.positions, m.indices, 4, stopped));
+    CHECK(bvh.nodes().empty());
+    CHECK(bvh.triangleCount() == 0);
+  }
+  SECTION("create") {
+    const auto made = MeshDistance::create(m, stopped);
+    REQUIRE_FALSE(made.ok());
+    CHECK(made.error().code == Status::timed_out);
+  }
+  SECTION("a deadline in the past stops it too") {
+    const auto made = MeshDistance::create(m, WorkLimit::after(std::chrono::seconds(-1)));
+    REQUIRE_FALSE(made.ok());
+    CHECK(made.error().code == Status::timed_out);
+  }
+  SECTION("updatePositions stopped in its check leaves the object as it was") {
+    const auto d = makeDistance(m);
+    const glm::vec3 probe(0.01f, 0.02f, -0.03f);
+    const float before = d->signedDistance(probe);
+    std::vector<glm::vec3> bigger = m.positions;
+    for (glm::vec3& p : bigger) p *= 1.5f;
+    CHECK(d->updatePositions(bigger, stopped) == Status::timed_out);
+    CHECK(d->signedDistance(probe) == before);
+    CHECK(d->mesh().positions == m.positions);
+  }
+  SECTION("a limit never reached changes no result") {
+    stop = false;
+    const auto limited = MeshDistance::create(m, stopped);
+    REQUIRE(limited.ok());
+    const auto plain = makeDistance(m);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> unit(-0.1f, 0.1f);
+    for (int i = 0; i < 50; ++i) {
+      const glm::vec3 p(unit(rng), unit(rng), unit(rng));
+      CHECK((*limited)->signedDistance(p) == plain->signedDistance(p));
+    }
   }
 }
 

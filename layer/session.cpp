@@ -120,8 +120,7 @@ XrResult XRAPI_CALL SdfgXrCreateSession(XrInstance instance, const XrSessionCrea
       state->config.sdfFarBand * std::max(spacing.x, std::max(spacing.y, spacing.z));
   // CPU builds, target set-ups and solves run on the session's worker thread, never inside the
   // app's calls; its builder uses that one thread (an app on a 2-core machine keeps the other).
-  s->grasp = std::make_unique<GraspSession>(makeCpuSdfBackend(1, cpuOptions), std::move(gpu),
-                                            GraspThreading::worker);
+  s->grasp = std::make_unique<GraspSession>(makeCpuSdfBackend(1, cpuOptions), std::move(gpu));
   s->grasp->setDeferredForMeshTargets(s->gpuForArrayTargets);
   if (Status st = s->grasp->configure(s->settings); st != Status::ok) {
     SDFG_LOG_WARN(cmd, "configured solver '%s' is not usable (%s); using 'paper'",

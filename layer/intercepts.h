@@ -70,7 +70,5 @@ void applyTargetSettings(SessionState& session, uint64_t target,
 
 // input.cpp: creates the layer's action set and actions on a new instance.
 void createLayerActions(InstanceState& instance);
-// hands.cpp: destroys the layer's internal trackers of a session (before it goes away).
-void destroyInternalTrackers(SessionState& session);
 
 }  // namespace sdfg::layer

@@ -363,6 +363,7 @@ const Route kRoutes[] = {
     SDFG_ROUTE(XrGetGraspStateSDFG, Gate::autoGrasp),
     SDFG_ROUTE(XrSetGraspOptionsSDFG, Gate::autoGrasp),
     SDFG_ROUTE(XrSetGraspTargetSettingsSDFG, Gate::autoGrasp),
+    SDFG_ROUTE(XrGetGraspTargetStateSDFG, Gate::autoGrasp),
 };
 
 XrResult XRAPI_CALL SdfgXrGetInstanceProcAddr(XrInstance instance, const char* name,

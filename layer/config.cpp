@@ -83,6 +83,7 @@ bool applyConfigValue(Config& config, const std::string& key, const std::string&
     ok = parseBool(value, c.synthesis);
   } else if (key == "gpu") {
     bool flag = false;
+    ok = false;
     if (value == "auto") {
       c.gpu = Config::Gpu::automatic;
       ok = true;

@@ -128,7 +128,7 @@ const TriangleMesh& sphere() {
 
 }  // namespace
 
-TEST_CASE("The owner's side never calls the device; pumps do, and carry results back",
+TEST_CASE("The owner's side never calls the device: pumps do, and carry results back",
           "[core][deferred_mailbox]") {
   Fixture f;
   const GridBox box = GridBox::referenceDefault();
@@ -231,7 +231,7 @@ TEST_CASE("exclusive runs the posted calls first, after the pump in progress",
   CHECK(seen == std::vector<std::string>{"posted", "posted later", "exclusive"});
 }
 
-TEST_CASE("A device failure shows on the owner's side; shutdown destroys the device",
+TEST_CASE("A device failure shows on the owner's side, and shutdown destroys the device",
           "[core][deferred_mailbox]") {
   Fixture f;
   REQUIRE(f.mailbox->pump(false));

@@ -29,16 +29,26 @@ bool parseBool(const std::string& text, bool& out) {
   return false;
 }
 
-const char* const kKeys[] = {"log_level",          "solver",
-                             "grab_threshold",     "release_ratio",
-                             "resolution",         "curl_step",
-                             "exact_check",        "sdf_far_band",
-                             "synthesis",          "gpu",
-                             "extra_queue",        "test_gpu_fault",
-                             "clear_hand",         "clear_bound",
-                             "approach",           "approach_range",
-                             "approach_max_angle", "offset_blend_time",
-                             "build_time_limit_ms"};
+const char* const kKeys[] = {"log_level",
+                             "solver",
+                             "grab_threshold",
+                             "release_ratio",
+                             "resolution",
+                             "curl_step",
+                             "exact_check",
+                             "sdf_far_band",
+                             "synthesis",
+                             "gpu",
+                             "extra_queue",
+                             "test_gpu_fault",
+                             "clear_hand",
+                             "clear_bound",
+                             "approach",
+                             "approach_range",
+                             "approach_max_angle",
+                             "offset_blend_time",
+                             "build_time_limit_ms",
+                             "test_layer_fault"};
 
 }  // namespace
 
@@ -73,6 +83,7 @@ bool applyConfigValue(Config& config, const std::string& key, const std::string&
     ok = parseBool(value, c.synthesis);
   } else if (key == "gpu") {
     bool flag = false;
+    ok = false;
     if (value == "auto") {
       c.gpu = Config::Gpu::automatic;
       ok = true;
@@ -94,6 +105,10 @@ bool applyConfigValue(Config& config, const std::string& key, const std::string&
     ok = parseFloat(value, 0.1f, 180.0f, c.approachMaxAngle);
   } else if (key == "offset_blend_time") {
     ok = parseFloat(value, 0.0f, 2.0f, c.offsetBlendTime);
+  } else if (key == "test_layer_fault") {
+    ok = value == "none" || value == "after_create_instance" || value == "after_create_session" ||
+         value == "after_create_space" || value == "after_create_tracker";
+    c.testLayerFault = value;
   } else if (key == "test_gpu_fault") {
     ok = value == "none" || value == "lost_at_submit" || value == "lost_at_poll" ||
          value == "never_ready";

@@ -36,6 +36,9 @@ struct Config {
   // test_gpu_fault: none, lost_at_submit, lost_at_poll (tests only: a simulated device loss),
   // never_ready (the GPU path never finishes preparing, as if the driver compiled forever)
   std::string testGpuFault = "none";
+  // test_layer_fault: none, or the point after a successful call down where the layer throws
+  // (test_fault.h), to check that it gives back what the runtime made.
+  std::string testLayerFault = "none";
   std::string configPath;  // the file that was read, empty when none
   // Never inside (docs/layer.md, "The hand's clearance"): clear_hand, clear_bound (metres),
   // approach, approach_range (metres), approach_max_angle (degrees), offset_blend_time (s).

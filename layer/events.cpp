@@ -1,4 +1,5 @@
-// Grasp events: what changed for a hand (queued from updateGrasps and xrDestroyGraspTargetSDFG)
+// Grasp events: what changed for a hand (queued from the grab update, xrDestroyGraspTargetSDFG
+// and xrDestroySpace)
 // and xrPollEvent's merge of the layer's queue with the runtime's events.
 #include "events.h"
 
@@ -59,7 +60,7 @@ void EventQueue::push(const XrEventDataGraspChangedSDFG& event) {
 void EventQueue::dropSession(XrSession session) {
   std::lock_guard lock(mutex_);
   std::erase_if(events_, [&](const auto& e) { return e.session == session; });
-  if (heldBack_ && runtimeEventSession(*heldBack_) == session) heldBack_.reset();
+  std::erase_if(heldBack_, [&](const auto& e) { return runtimeEventSession(e) == session; });
 }
 
 size_t EventQueue::dropped() const {
@@ -69,29 +70,44 @@ size_t EventQueue::dropped() const {
 
 XrResult EventQueue::poll(PFN_xrPollEvent next, XrInstance instance, XrEventDataBuffer* out) {
   constexpr const char* cmd = "xrPollEvent";
-  std::lock_guard lock(mutex_);
-  if (events_.empty() && !heldBack_) return next(instance, out);
+  std::unique_lock lock(mutex_);
+  if (events_.empty() && heldBack_.empty()) {
+    lock.unlock();
+    return next(instance, out);
+  }
+  lock.unlock();
   if (out == nullptr) return logError(XR_ERROR_VALIDATION_FAILURE, cmd, "(eventData) is null");
   if (out->type != XR_TYPE_EVENT_DATA_BUFFER)
     return logError(XR_ERROR_VALIDATION_FAILURE, cmd, "(eventData->type) is %d", int(out->type));
-  if (!heldBack_) {
+  lock.lock();
+  if (heldBack_.empty()) {
+    // The runtime's next event, asked with no lock held; another thread polling meanwhile may
+    // hold one back too: they queue in the order the runtime gave them.
+    lock.unlock();
     XrEventDataBuffer e{XR_TYPE_EVENT_DATA_BUFFER};
     const XrResult r = next(instance, &e);
-    if (r == XR_SUCCESS)
-      heldBack_ = e;
-    else if (r != XR_EVENT_UNAVAILABLE)
+    if (r != XR_SUCCESS && r != XR_EVENT_UNAVAILABLE)
       return r;  // the runtime's error (instance lost ...): the app must see it
+    lock.lock();
+    if (r == XR_SUCCESS) heldBack_.push_back(e);
   }
+  const std::optional<XrTime> runtimeTime =
+      heldBack_.empty() ? std::nullopt : runtimeEventTime(heldBack_.front());
   const bool layerFirst =
-      !events_.empty() && (!heldBack_ || (runtimeEventTime(*heldBack_) &&
-                                          events_.front().time < *runtimeEventTime(*heldBack_)));
+      !events_.empty() &&
+      (heldBack_.empty() || (runtimeTime && events_.front().time < *runtimeTime));
   if (layerFirst) {
     copyOut(events_.front(), out);
     events_.pop_front();
     return XR_SUCCESS;
   }
-  *out = *heldBack_;
-  heldBack_.reset();
+  if (heldBack_.empty()) {
+    // Both queues emptied by another thread meanwhile.
+    lock.unlock();
+    return next(instance, out);
+  }
+  *out = heldBack_.front();
+  heldBack_.pop_front();
   return XR_SUCCESS;
 }
 
@@ -100,7 +116,7 @@ void noteGraspChange(SessionState& s, Hand hand, bool wasGrasping, uint64_t wasT
   InstanceState& inst = *s.instance;
   if (!inst.appAutoGrasp || s.grasp == nullptr) return;
   const HandGrasp& g = s.grasp->grasp(hand);
-  const bool grasping = !destroyed && g.holding && g.solves > 0;
+  const bool grasping = !destroyed && g.shown();
   const uint64_t target = grasping ? g.target : 0;
   XrEventDataGraspChangedSDFG e{XR_TYPE_EVENT_DATA_GRASP_CHANGED_SDFG};
   e.session = s.handle;

@@ -1,6 +1,7 @@
 // The layer's own events (XR_SDFG_auto_grasp version 2: XrEventDataGraspChangedSDFG) and how
 // xrPollEvent interleaves them with the runtime's: a small bounded queue per instance, and at
-// most one runtime event held back while an earlier layer event goes first.
+// runtime events held back (at most one per thread polling at once) while an earlier layer event
+// goes first. The queue's lock is never held across the runtime's xrPollEvent.
 #pragma once
 
 #include <cstddef>
@@ -31,7 +32,7 @@ class EventQueue {
  private:
   mutable std::mutex mutex_;  // guards everything below
   std::deque<XrEventDataGraspChangedSDFG> events_;
-  std::optional<XrEventDataBuffer> heldBack_;  // a runtime event polled but not yet returned
+  std::deque<XrEventDataBuffer> heldBack_;  // runtime events polled but not yet returned
   size_t dropped_ = 0;
 };
 

@@ -1,5 +1,7 @@
 // XR_SDFG_auto_grasp entry points. Each: resolve and check the handle, one check per argument,
-// one call into the core, one conversion of the result. A failing call changes nothing.
+// one call into the core, one conversion of the result. A failing call changes nothing. The
+// session's lock is taken only to hand over to the engine: copies of the app's arrays happen
+// before it, log lines of refusals after it (docs/threading.md).
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -44,18 +46,49 @@ std::pair<std::shared_ptr<TargetState>, std::shared_ptr<SessionState>> findTarge
   return {t, s};
 }
 
-XrResult verifyPlacement(const char* cmd, const SessionState& s,
-                         const XrGraspTargetPlacementSDFG* placement) {
+// The placement's own checks; whether its space is one of the session's is checked under the
+// session's lock (liveSpace).
+XrResult verifyPlacement(const char* cmd, const XrGraspTargetPlacementSDFG* placement) {
   SDFG_VERIFY_TYPE(cmd, placement, XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG);
   SDFG_VERIFY_CHAIN(cmd, placement->next);
   SDFG_VERIFY(cmd, placement->space != XR_NULL_HANDLE, XR_ERROR_HANDLE_INVALID,
               "(placement->space) is XR_NULL_HANDLE");
-  SDFG_VERIFY(cmd, s.spaces.count(key(placement->space)) != 0, XR_ERROR_HANDLE_INVALID,
-              "(placement->space) is not a reference or action space of this session");
   SDFG_VERIFY(cmd, isFinitePose(placement->pose), XR_ERROR_VALIDATION_FAILURE,
               "(placement->pose) is not finite");
   SDFG_VERIFY(cmd, isUnitQuaternion(placement->pose.orientation), XR_ERROR_POSE_INVALID,
               "(placement->pose.orientation) is not a unit quaternion");
+  return XR_SUCCESS;
+}
+
+// A reference or action space the app made on `s` and has not destroyed (nor is destroying).
+// The caller holds s.mutex.
+bool liveSpace(const SessionState& s, XrSpace space) {
+  const auto use = s.spaces.find(key(space));
+  return use != s.spaces.end() && !use->second.dying;
+}
+
+// Why a call found the session unable to take it, read under the session's lock and logged
+// after it (the log may call the runtime).
+enum class Refusal { none, sessionLost, notASpace, noGpu, engine };
+
+XrResult refuse(const char* cmd, Refusal why, Status engine = Status::ok) {
+  switch (why) {
+    case Refusal::none:
+      break;
+    case Refusal::sessionLost:
+      return logError(XR_ERROR_SESSION_LOST, cmd, "the session is being destroyed");
+    case Refusal::notASpace:
+      return logError(XR_ERROR_HANDLE_INVALID, cmd,
+                      "(placement->space) is not a reference or action space of this session");
+    case Refusal::noGpu:
+      return logError(XR_ERROR_FEATURE_UNSUPPORTED, cmd,
+                      "this session builds its SDFs on the CPU (gpu = false, no usable Vulkan "
+                      "device, or a GPU failure): Vulkan buffer targets need the GPU path; pass "
+                      "arrays");
+    case Refusal::engine:
+      return logError(toXrResult(engine), cmd, "refused by the grasp engine (%s)",
+                      toString(engine));
+  }
   return XR_SUCCESS;
 }
 
@@ -241,31 +274,35 @@ Aabb toBounds(const XrGraspTargetVulkanBuffersSDFG& b) {
   return a;
 }
 
-// Creates a buffer target on a Vulkan session (the caller holds the session lock).
-XrResult createBufferTarget(const char* cmd, SessionState& s,
-                            const XrGraspTargetVulkanBuffersSDFG* buffers, TargetState& t) {
-  SDFG_VERIFY(cmd, s.vulkan, XR_ERROR_GRAPHICS_DEVICE_INVALID,
-              "Vulkan buffers need a session with a Vulkan graphics binding");
-  if (XrResult r = verifyBuffers(cmd, buffers, nullptr); r != XR_SUCCESS) return r;
+// The GPU path's calls for a buffer target, made on the device by the next pump (no wait here).
+void postDeviceMesh(DeferredMailbox& gpu, uint64_t id, const XrGraspTargetVulkanBuffersSDFG& b) {
 #if SDFG_LAYER_VULKAN
-  SDFG_VERIFY(cmd, s.vulkanBackend != nullptr && s.grasp->deferredUsable(),
-              XR_ERROR_FEATURE_UNSUPPORTED,
-              "this session builds its SDFs on the CPU (gpu = false, no usable Vulkan device, or "
-              "a GPU failure): Vulkan buffer targets need the GPU path; pass arrays");
-  if (Status st = s.vulkanBackend->setDeviceMesh(t.handle, toMeshBuffers(*buffers));
-      st != Status::ok)
-    return logError(toXrResult(st), cmd, "the buffers were refused (%s)", toString(st));
-  if (Status st = s.grasp->addDeviceTarget(t.handle, toBounds(*buffers)); st != Status::ok) {
-    s.vulkanBackend->removeDeviceMesh(t.handle);
-    return logError(toXrResult(st), cmd, "the target could not be added (%s)", toString(st));
-  }
-  t.vertexCount = buffers->vertexCount;
-  t.indexCount = buffers->indexCount;
-  t.deviceBuffers = true;
-  return XR_SUCCESS;
+  const VkMeshBuffers buffers = toMeshBuffers(b);
+  gpu.post([id, buffers](DeferredSdfBackend& device) {
+    (void)static_cast<VkGraspBackend&>(device).setDeviceMesh(id, buffers);
+  });
+  gpu.noteDeviceMesh(id, true);
 #else
-  return logError(XR_ERROR_FEATURE_UNSUPPORTED, cmd,
-                  "this build of the layer has no Vulkan backend; pass arrays");
+  (void)gpu;
+  (void)id;
+  (void)b;
+#endif
+}
+
+void removeDeviceMesh(DeferredMailbox& gpu, uint64_t id, bool wait) {
+  gpu.noteDeviceMesh(id, false);
+#if SDFG_LAYER_VULKAN
+  const auto remove = [id](DeferredSdfBackend& device) {
+    static_cast<VkGraspBackend&>(device).removeDeviceMesh(id);
+  };
+  // Waiting: the GPU's reads of the app's buffers end before the call returns, so the app may
+  // free them next.
+  if (wait)
+    gpu.exclusive(remove);
+  else
+    gpu.post(remove);
+#else
+  (void)wait;
 #endif
 }
 
@@ -295,42 +332,57 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
   const auto* settings = findInChain<const XrGraspTargetSettingsSDFG>(
       createInfo->next, XR_TYPE_GRASP_TARGET_SETTINGS_SDFG);
   if (XrResult r = verifyTargetSettings(cmd, settings); r != XR_SUCCESS) return r;
-  std::lock_guard lock(s->mutex);
-  SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
-  if (XrResult r = verifyPlacement(cmd, *s, &createInfo->placement); r != XR_SUCCESS) return r;
-  if (buffers != nullptr) {
-    auto t = std::make_shared<TargetState>();
-    t->handle = newLayerHandle();
-    t->session = s;
-    t->space = createInfo->placement.space;
-    t->pose = createInfo->placement.pose;
-    if (XrResult r = createBufferTarget(cmd, *s, buffers, *t); r != XR_SUCCESS) return r;
-    applyTargetSettings(*s, t->handle, settings);
-    s->targets[t->handle] = t;
-    *target = fromKey<XrGraspTargetSDFG>(t->handle);
-    const uint64_t handle = t->handle;
-    targets().insert(handle, std::move(t));
-    return XR_SUCCESS;
-  }
+  if (XrResult r = verifyPlacement(cmd, &createInfo->placement); r != XR_SUCCESS) return r;
+  // The checks and the copy of the app's arrays (up to 2^24 vertices) happen before the lock.
   TriangleMesh mesh;
-  if (XrResult r = copyArrays(cmd, arrays, mesh); r != XR_SUCCESS) return r;
-  // The rest of the set-up runs on the session's worker: the zero-area check, turning every part
-  // outward (meshes come wound either way, or both), the BVH. updateGrasps logs once what it
-  // found, or why it refused the mesh, and XrGraspTargetsSetupInfoSDFG reports it.
+  if (buffers != nullptr) {
+    // Fixed when the session was made: no lock needed.
+    SDFG_VERIFY(cmd, s->vulkan, XR_ERROR_GRAPHICS_DEVICE_INVALID,
+                "Vulkan buffers need a session with a Vulkan graphics binding");
+    if (XrResult r = verifyBuffers(cmd, buffers, nullptr); r != XR_SUCCESS) return r;
+  } else if (XrResult r = copyArrays(cmd, arrays, mesh); r != XR_SUCCESS) {
+    return r;
+  }
   auto t = std::make_shared<TargetState>();
   t->handle = newLayerHandle();
   t->session = s;
   t->space = createInfo->placement.space;
   t->pose = createInfo->placement.pose;
-  t->vertexCount = arrays->vertexCount;
-  t->indexCount = arrays->indexCount;
-  if (Status st = s->grasp->addTarget(t->handle, std::move(mesh)); st != Status::ok)
-    return logError(toXrResult(st), cmd, "the target could not be built (%s)", toString(st));
-  applyTargetSettings(*s, t->handle, settings);
-  s->targets[t->handle] = t;
-  *target = fromKey<XrGraspTargetSDFG>(t->handle);
+  t->vertexCount = buffers != nullptr ? buffers->vertexCount : arrays->vertexCount;
+  t->indexCount = buffers != nullptr ? buffers->indexCount : arrays->indexCount;
+  t->deviceBuffers = buffers != nullptr;
+  Refusal refusal = Refusal::none;
+  Status status = Status::ok;
+  {
+    std::lock_guard lock(s->mutex);
+    if (s->grasp == nullptr) {
+      refusal = Refusal::sessionLost;
+    } else if (!liveSpace(*s, createInfo->placement.space)) {
+      refusal = Refusal::notASpace;
+    } else if (buffers != nullptr) {
+      if (s->gpu == nullptr || !s->grasp->deferredUsable()) refusal = Refusal::noGpu;
+      if (refusal == Refusal::none) {
+        // Registered on the device by the next pump, before any build the engine asks for it.
+        postDeviceMesh(*s->gpu, t->handle, *buffers);
+        status = s->grasp->addDeviceTarget(t->handle, toBounds(*buffers));
+        if (status != Status::ok) removeDeviceMesh(*s->gpu, t->handle, false);
+      }
+    } else {
+      // The rest of the set-up runs on the session's worker: the zero-area check, turning every
+      // part outward (meshes come wound either way, or both), the BVH. syncGrasps logs once what
+      // it found, or why it refused the mesh, and XrGraspTargetsSetupInfoSDFG reports it.
+      status = s->grasp->addTarget(t->handle, std::move(mesh));
+    }
+    if (refusal == Refusal::none && status == Status::ok) {
+      applyTargetSettings(*s, t->handle, settings);
+      s->targets[t->handle] = t;
+    }
+  }
+  if (refusal == Refusal::none && status != Status::ok) refusal = Refusal::engine;
+  if (refusal != Refusal::none) return refuse(cmd, refusal, status);
   const uint64_t handle = t->handle;
   targets().insert(handle, std::move(t));
+  *target = fromKey<XrGraspTargetSDFG>(handle);
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)
 }
@@ -340,22 +392,25 @@ XrResult XRAPI_CALL SdfgXrDestroyGraspTargetSDFG(XrGraspTargetSDFG target) {
   SDFG_ENTRY_BEGIN
   auto [t, s] = findTarget(target);
   SDFG_VERIFY(cmd, t != nullptr, XR_ERROR_HANDLE_INVALID, "(target) is not valid");
-  std::lock_guard lock(s->mutex);
-  // A hand holding it lets go; its fingers return to the user's pose at the next locate.
-  if (s->grasp != nullptr) {
-    for (Hand hand : {Hand::left, Hand::right}) {
-      const HandGrasp& g = s->grasp->grasp(hand);
-      if (g.holding && g.solves > 0 && g.target == t->handle)
-        noteGraspChange(*s, hand, true, t->handle, /*destroyed=*/true);
+  std::shared_ptr<DeferredMailbox> gpu;
+  {
+    std::lock_guard lock(s->mutex);
+    // A hand holding it lets go; its fingers return to the user's pose at the next locate.
+    if (s->grasp != nullptr) {
+      for (Hand hand : {Hand::left, Hand::right}) {
+        const HandGrasp& g = s->grasp->grasp(hand);
+        if (g.shown() && g.target == t->handle)
+          noteGraspChange(*s, hand, true, t->handle, /*destroyed=*/true);
+      }
+      s->grasp->removeTarget(t->handle);
+      publishShownHands(*s);  // the next locate shows the hand let go
     }
-    s->grasp->removeTarget(t->handle);
+    s->targets.erase(t->handle);
+    if (t->deviceBuffers) gpu = s->gpu;
   }
-#if SDFG_LAYER_VULKAN
-  // Waits for the layer's reads of the app's buffers in flight: the app may free them next.
-  if (t->deviceBuffers && s->vulkanBackend != nullptr)
-    s->vulkanBackend->removeDeviceMesh(t->handle);
-#endif
-  s->targets.erase(t->handle);
+  // Waits, with no lock held, for a pump in progress and then for the layer's reads of the
+  // app's buffers in flight: the app may free them when this returns.
+  if (gpu != nullptr) removeDeviceMesh(*gpu, t->handle, true);
   targets().erase(t->handle);
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)
@@ -371,47 +426,62 @@ XrResult XRAPI_CALL SdfgXrUpdateGraspTargetVerticesSDFG(XrGraspTargetSDFG target
   const auto* base = static_cast<const XrBaseInStructure*>(vertices);
   SDFG_VERIFY_CHAIN(cmd, base->next);
   const int32_t type = rawEnum(base->type);
+  Refusal refusal = Refusal::none;
+  Status status = Status::ok;
   if (type == XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG) {
     const auto* b = static_cast<const XrGraspTargetVulkanBuffersSDFG*>(vertices);
     SDFG_VERIFY(cmd, t->deviceBuffers, XR_ERROR_VALIDATION_FAILURE,
                 "(vertices) are Vulkan buffers; the target was created from arrays");
     if (XrResult r = verifyBuffers(cmd, b, t.get()); r != XR_SUCCESS) return r;
-    std::lock_guard lock(s->mutex);
-    SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
-#if SDFG_LAYER_VULKAN
-    SDFG_VERIFY(cmd, s->vulkanBackend != nullptr && s->grasp->deferredUsable(),
-                XR_ERROR_FEATURE_UNSUPPORTED,
-                "the session's GPU path failed: buffer targets can no longer be grasped");
-    if (Status st = s->vulkanBackend->setDeviceMesh(t->handle, toMeshBuffers(*b)); st != Status::ok)
-      return logError(toXrResult(st), cmd, "the buffers were refused (%s)", toString(st));
-    (void)s->grasp->touchTarget(t->handle);
-    (void)s->grasp->updateTargetBounds(t->handle, toBounds(*b));
-    return XR_SUCCESS;
-#else
-    return logError(XR_ERROR_FEATURE_UNSUPPORTED, cmd, "no Vulkan backend in this build");
-#endif
+    {
+      std::lock_guard lock(s->mutex);
+      if (s->grasp == nullptr) {
+        refusal = Refusal::sessionLost;
+      } else if (s->gpu == nullptr || !s->grasp->deferredUsable()) {
+        refusal = Refusal::noGpu;
+      } else {
+        // The new buffers reach the device before the build the touch asks for (posted calls
+        // run first in a pump).
+        postDeviceMesh(*s->gpu, t->handle, *b);
+        status = s->grasp->touchTarget(t->handle);
+        if (status == Status::ok) status = s->grasp->updateTargetBounds(t->handle, toBounds(*b));
+      }
+    }
+    if (refusal == Refusal::none && status != Status::ok) refusal = Refusal::engine;
+    return refuse(cmd, refusal, status);
   }
   SDFG_VERIFY(cmd, type == XR_TYPE_GRASP_TARGET_VERTICES_SDFG, XR_ERROR_VALIDATION_FAILURE,
               "(vertices->type) is %d, expected XR_TYPE_GRASP_TARGET_VERTICES_SDFG", int(type));
   SDFG_VERIFY(cmd, !t->deviceBuffers, XR_ERROR_VALIDATION_FAILURE,
               "(vertices) are arrays; the target was created from Vulkan buffers");
   const auto* v = static_cast<const XrGraspTargetVerticesSDFG*>(vertices);
+  // A buffer the session's worker is done with (no allocation, no fresh pages), taken under the
+  // lock; the one pass over the app's array (check, copy, bound) happens outside it. A deforming
+  // mesh pays this every frame on the app's thread; everything else is the worker's: the refit,
+  // and refusing positions that collapse a triangle (the target keeps its last shape; syncGrasps
+  // logs it once). Checked here, that gather over every triangle was most of the 3.9 ms a frame
+  // the 400k-triangle armadillo's updates cost (docs/benchmarks.md, frame cost).
+  std::vector<glm::vec3> positions;
+  {
+    std::lock_guard lock(s->mutex);
+    if (s->grasp == nullptr)
+      refusal = Refusal::sessionLost;
+    else
+      positions = s->grasp->vertexBuffer(t->handle);
+  }
+  if (refusal != Refusal::none) return refuse(cmd, refusal);
   Aabb bounds;
-  std::lock_guard lock(s->mutex);
-  SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
-  // One pass over the app's array: check, copy into a buffer the session's worker is done with
-  // (no allocation, no fresh pages) and bound. A deforming mesh pays this every frame on the
-  // app's thread; everything else is the worker's: the refit, and refusing positions that
-  // collapse a triangle (the target keeps its last shape; updateGrasps logs it once). Checked
-  // here, that gather over every triangle was most of the 3.9 ms a frame the 400k-triangle
-  // armadillo's updates cost (docs/benchmarks.md, frame cost).
-  std::vector<glm::vec3> positions = s->grasp->vertexBuffer(t->handle);
   if (XrResult r = copyVertices(cmd, v, t->vertexCount, positions, bounds); r != XR_SUCCESS)
     return r;
-  if (Status st = s->grasp->updateTargetVertices(t->handle, std::move(positions), bounds);
-      st != Status::ok)
-    return logError(toXrResult(st), cmd, "the vertices were refused (%s)", toString(st));
-  return XR_SUCCESS;
+  {
+    std::lock_guard lock(s->mutex);
+    if (s->grasp == nullptr)
+      refusal = Refusal::sessionLost;
+    else
+      status = s->grasp->updateTargetVertices(t->handle, std::move(positions), bounds);
+  }
+  if (refusal == Refusal::none && status != Status::ok) refusal = Refusal::engine;
+  return refuse(cmd, refusal, status);
   SDFG_ENTRY_END(cmd)
 }
 
@@ -421,11 +491,20 @@ XrResult XRAPI_CALL SdfgXrSetGraspTargetPlacementSDFG(XrGraspTargetSDFG target,
   SDFG_ENTRY_BEGIN
   auto [t, s] = findTarget(target);
   SDFG_VERIFY(cmd, t != nullptr, XR_ERROR_HANDLE_INVALID, "(target) is not valid");
-  std::lock_guard lock(s->mutex);
-  if (XrResult r = verifyPlacement(cmd, *s, placement); r != XR_SUCCESS) return r;
-  t->space = placement->space;
-  t->pose = placement->pose;
-  return XR_SUCCESS;
+  if (XrResult r = verifyPlacement(cmd, placement); r != XR_SUCCESS) return r;
+  Refusal refusal = Refusal::none;
+  {
+    std::lock_guard lock(s->mutex);
+    if (!liveSpace(*s, placement->space)) {
+      refusal = Refusal::notASpace;
+    } else {
+      // Placed again (also after its space was destroyed): it takes part from the next sync.
+      t->space = placement->space;
+      t->pose = placement->pose;
+      t->placed = true;
+    }
+  }
+  return refuse(cmd, refusal);
   SDFG_ENTRY_END(cmd)
 }
 
@@ -444,10 +523,13 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
   SDFG_VERIFY(cmd, handValue == XR_HAND_LEFT_EXT || handValue == XR_HAND_RIGHT_EXT,
               XR_ERROR_VALIDATION_FAILURE, "(getInfo->hand) is %d", int(handValue));
   const Hand hand = handValue == XR_HAND_LEFT_EXT ? Hand::left : Hand::right;
-  std::lock_guard lock(s->mutex);
-  SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
+  std::unique_lock lock(s->mutex);
+  if (s->grasp == nullptr) {
+    lock.unlock();
+    return refuse(cmd, Refusal::sessionLost);
+  }
   const HandGrasp& g = s->grasp->grasp(hand);
-  const bool held = g.holding && g.solves > 0;
+  const bool held = g.shown();
   state->isGrasping = held ? XR_TRUE : XR_FALSE;
   state->target = held ? fromKey<XrGraspTargetSDFG>(g.target) : XR_NULL_HANDLE;
   state->squeeze = s->squeeze[hand == Hand::left ? 0 : 1];
@@ -532,8 +614,11 @@ XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession session,
   ClearanceRequest clearance;
   if (XrResult r = readClearanceOptions(cmd, o.next, clearance); r != XR_SUCCESS) return r;
 
-  std::lock_guard lock(s->mutex);
-  SDFG_VERIFY(cmd, s->grasp != nullptr, XR_ERROR_SESSION_LOST, "the session is being destroyed");
+  std::unique_lock lock(s->mutex);
+  if (s->grasp == nullptr) {
+    lock.unlock();
+    return refuse(cmd, Refusal::sessionLost);
+  }
   GraspSettings settings = settingsFromConfig(s->instance->config);
   if (solver == XR_GRASP_SOLVER_PAPER_SDFG) settings.solver = "paper";
   if (solver == XR_GRASP_SOLVER_OURS_SDFG) settings.solver = "ours";
@@ -547,12 +632,14 @@ XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession session,
   if (o.grabThreshold != 0.0f) settings.grabThreshold = o.grabThreshold;
   float blendTime = s->instance->config.offsetBlendTime;
   clearance.apply(settings, blendTime);
-  if (Status st = s->grasp->configure(settings); st != Status::ok)
+  if (Status st = s->grasp->configure(settings); st != Status::ok) {
+    lock.unlock();
     return logError(st == Status::invalid_argument && solver == XR_GRASP_SOLVER_OURS_SDFG
                         ? XR_ERROR_FEATURE_UNSUPPORTED
                         : toXrResult(st),
                     cmd, "the options were refused (%s; solver '%s')", toString(st),
                     settings.solver.c_str());
+  }
   s->settings = settings;
   s->offsets.blendTime = blendTime;
   return XR_SUCCESS;

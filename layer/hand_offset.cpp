@@ -1,10 +1,8 @@
-// The hand's offset off its tracked pose: blend, joints, report and options (hand_offset.h).
+// The hand's offset as the extension sees it: its options and its report (hand_offset.h).
 #include "hand_offset.h"
 
 #include <algorithm>
 #include <cmath>
-
-#include <glm/gtc/quaternion.hpp>
 
 #include "log.h"
 #include "state.h"
@@ -25,56 +23,11 @@ void ClearanceRequest::apply(GraspSettings& settings, float& blendTime) const {
   if (o.blendTime != 0.0f) blendTime = o.blendTime;
 }
 
-void advanceHandOffset(SessionState& s, int h) {
-  if (s.grasp == nullptr) return;
-  HandOffset& o = s.offsets.hands[size_t(h)];
-  const HandGrasp& g = s.grasp->grasp(h == 0 ? Hand::left : Hand::right);
-  const bool held = g.holding && g.solves > 0;
-  if (held) {
-    // Nothing shown yet: the new grasp's correction is taken whole, the blend brings it in.
-    if (o.blend <= 0.0f) o.current = g.result.handCorrection;
-    o.solved = g.result.handCorrection;
-    o.openClearance = std::isfinite(g.result.openClearance) ? g.result.openClearance : 0.0f;
-    o.displacement = g.result.handMoved;
-    o.exceeded = g.result.clearanceExceeded;
-  }
-  // Time, not frames: the blend takes as long at 60 Hz as at 120 Hz. A stalled app (a long gap)
-  // steps at most a quarter second.
-  const double dt =
-      o.last == 0 || s.predictedTime <= o.last ? 0.0 : double(s.predictedTime - o.last) * 1e-9;
-  o.last = s.predictedTime;
-  const float step =
-      s.offsets.blendTime > 0.0f ? float(std::min(dt, 0.25) / s.offsets.blendTime) : 1.0f;
-  o.blend = std::clamp(o.blend + (held ? step : -step), 0.0f, 1.0f);
-  const float follow = std::min(step, 1.0f);
-  o.current.position = glm::mix(o.current.position, o.solved.position, follow);
-  o.current.orientation =
-      glm::normalize(glm::slerp(o.current.orientation, o.solved.orientation, follow));
-}
-
-Pose shownHandOffset(const HandOffset& o) {
-  if (o.blend <= 0.0f) return Pose{};
-  // Smoothstep: the hand starts and ends its move at rest.
-  const float w = o.blend * o.blend * (3.0f - 2.0f * o.blend);
-  Pose p;
-  p.position = o.current.position * w;
-  p.orientation =
-      glm::normalize(glm::slerp(glm::quat(1.0f, 0.0f, 0.0f, 0.0f), o.current.orientation, w));
-  return p;
-}
-
-void applyHandOffset(const Pose& offset, JointPoses& joints) {
-  const Pose wrist = joints[size_t(Joint::wrist)];
-  const Pose move = wrist * offset * wrist.inverse();
-  for (Pose& j : joints) j = move * j;
-}
-
 void writeHandOffset(const SessionState& s, int h, void* next) {
   auto* out = findInChain<XrGraspHandOffsetSDFG>(next, XR_TYPE_GRASP_HAND_OFFSET_SDFG);
   if (out == nullptr) return;
   const HandOffset& o = s.offsets.hands[size_t(h)];
-  const HandGrasp& g = s.grasp->grasp(h == 0 ? Hand::left : Hand::right);
-  const bool held = g.holding && g.solves > 0;
+  const bool held = s.grasp->grasp(h == 0 ? Hand::left : Hand::right).shown();
   out->offset = toXr(shownHandOffset(o));
   out->solvedOffset = toXr(held ? o.solved : Pose{});
   out->blend = o.blend;

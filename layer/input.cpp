@@ -2,6 +2,7 @@
 // into the app's suggested bindings, attached with the app's sets and synced with every app sync
 // (notes/openxr-layer.md section 12). Priority 0 and bindings added only to profiles the app
 // suggests, so the app's actions report exactly what they would without the layer.
+#include <array>
 #include <cstring>
 #include <vector>
 
@@ -67,8 +68,10 @@ void appendLayerBindings(const InstanceState& instance, const ProfilePaths& path
 
 // An app without suggestions gets the layer's alone, on every profile it knows.
 void suggestOwnBindingsIfAlone(InstanceState& inst) {
-  std::lock_guard lock(inst.inputMutex);
-  if (!inst.appSuggestedProfiles.empty()) return;
+  {
+    std::lock_guard lock(inst.inputMutex);
+    if (!inst.appSuggestedProfiles.empty()) return;
+  }
   for (const ProfilePaths& paths : inst.profiles) {
     if (paths.profile == XR_NULL_PATH) continue;
     std::vector<XrActionSuggestedBinding> own;
@@ -81,22 +84,38 @@ void suggestOwnBindingsIfAlone(InstanceState& inst) {
   }
 }
 
-// The grip spaces and the LOCAL space the grab update works in. The caller holds s.mutex.
+// The grip spaces and the LOCAL space the grab update works in, made on the runtime with no
+// lock held, then stored. Made once: a second caller (two attaches cannot both succeed) finds
+// them set and gives its own back.
 void createLayerSpaces(SessionState& s) {
   auto& next = s.instance->next;
-  for (int h = 0; h < 2; ++h) {
+  std::array<XrSpace, 2> grips{};
+  for (size_t h = 0; h < 2; ++h) {
     XrActionSpaceCreateInfo spaceInfo{XR_TYPE_ACTION_SPACE_CREATE_INFO};
     spaceInfo.action = s.instance->gripAction;
     spaceInfo.subactionPath = s.instance->handPaths[h];
     spaceInfo.poseInActionSpace.orientation.w = 1.0f;
-    if (next.xrCreateActionSpace(s.handle, &spaceInfo, &s.gripSpaces[h]) != XR_SUCCESS)
-      s.gripSpaces[h] = XR_NULL_HANDLE;
+    if (next.xrCreateActionSpace(s.handle, &spaceInfo, &grips[h]) != XR_SUCCESS)
+      grips[h] = XR_NULL_HANDLE;
   }
+  XrSpace localSpace = XR_NULL_HANDLE;
   XrReferenceSpaceCreateInfo local{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};
   local.referenceSpaceType = XR_REFERENCE_SPACE_TYPE_LOCAL;
   local.poseInReferenceSpace.orientation.w = 1.0f;
-  if (next.xrCreateReferenceSpace(s.handle, &local, &s.localSpace) != XR_SUCCESS)
-    s.localSpace = XR_NULL_HANDLE;
+  if (next.xrCreateReferenceSpace(s.handle, &local, &localSpace) != XR_SUCCESS)
+    localSpace = XR_NULL_HANDLE;
+  bool stored = false;
+  {
+    std::lock_guard lock(s.mutex);
+    if (s.localSpace == XR_NULL_HANDLE && s.gripSpaces == std::array<XrSpace, 2>{}) {
+      s.gripSpaces = grips;
+      s.localSpace = localSpace;
+      stored = true;
+    }
+  }
+  if (stored) return;
+  for (XrSpace space : {grips[0], grips[1], localSpace})
+    if (space != XR_NULL_HANDLE) next.xrDestroySpace(space);
 }
 
 }  // namespace
@@ -104,39 +123,51 @@ void createLayerSpaces(SessionState& s) {
 void selfAttachIfNeeded(SessionState& s) {
   constexpr const char* cmd = "xrWaitFrame";
   InstanceState& inst = *s.instance;
-  if (s.attached || s.appAttached || s.selfAttachFailed || s.synthesizedTrackers == 0 ||
-      inst.actionSet == XR_NULL_HANDLE)
-    return;
+  {
+    // Claimed under the lock, attached without it.
+    std::lock_guard lock(s.mutex);
+    if (s.attached || s.appAttached || s.selfAttachFailed || s.selfAttaching ||
+        s.synthesizedTrackers == 0 || inst.actionSet == XR_NULL_HANDLE)
+      return;
+    s.selfAttaching = true;
+  }
   suggestOwnBindingsIfAlone(inst);
   XrSessionActionSetsAttachInfo info{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
   info.countActionSets = 1;
   info.actionSets = &inst.actionSet;
   const XrResult r = inst.next.xrAttachSessionActionSets(s.handle, &info);
-  if (XR_FAILED(r)) {
-    // Remembered: never tried again on this session.
-    s.selfAttachFailed = true;
+  if (XR_SUCCEEDED(r)) createLayerSpaces(s);
+  {
+    std::lock_guard lock(s.mutex);
+    s.selfAttaching = false;
+    // A failure is remembered: never tried again on this session.
+    s.selfAttachFailed = XR_FAILED(r);
+    s.attached = s.attached || XR_SUCCEEDED(r);
+    s.selfAttached = XR_SUCCEEDED(r);
+  }
+  if (XR_FAILED(r))
     SDFG_LOG_WARN(cmd,
                   "could not attach the layer's action set (%d); synthesized hands stay "
                   "inactive in this session",
                   int(r));
-    return;
-  }
-  SDFG_LOG_INFO(cmd,
-                "the app attached no action sets: the layer attached its own so that "
-                "synthesized hands follow the controllers (a later app attach is refused)");
-  s.attached = true;
-  s.selfAttached = true;
-  createLayerSpaces(s);
+  else
+    SDFG_LOG_INFO(cmd,
+                  "the app attached no action sets: the layer attached its own so that "
+                  "synthesized hands follow the controllers (a later app attach is refused)");
 }
 
 void syncOwnActions(SessionState& s) {
+  {
+    std::lock_guard lock(s.mutex);
+    if (!s.selfAttached) return;
+  }
   InstanceState& inst = *s.instance;
   XrActiveActionSet active{inst.actionSet, XR_NULL_PATH};
   XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
   sync.countActiveActionSets = 1;
   sync.activeActionSets = &active;
   const XrResult r = inst.next.xrSyncActions(s.handle, &sync);
-  if (r == XR_SUCCESS || r == XR_SESSION_NOT_FOCUSED) updateGrasps(s);
+  if (r == XR_SUCCESS || r == XR_SESSION_NOT_FOCUSED) syncGrasps(s, "xrWaitFrame");
 }
 
 void createLayerActions(InstanceState& instance) {
@@ -251,16 +282,18 @@ XrResult XRAPI_CALL SdfgXrAttachSessionActionSets(XrSession session,
   if (XR_FAILED(r)) {
     const XrResult own = next.xrAttachSessionActionSets(session, info);
     if (XR_SUCCEEDED(own)) {
+      {
+        std::lock_guard lock(s->mutex);
+        s->appAttached = true;
+      }
       SDFG_LOG_WARN(cmd, "could not attach the layer's action set (%d)", int(r));
-      std::lock_guard lock(s->mutex);
-      s->appAttached = true;
     }
     return own;
   }
+  createLayerSpaces(*s);
   std::lock_guard lock(s->mutex);
   s->attached = true;
   s->appAttached = true;
-  createLayerSpaces(*s);
   return r;
   SDFG_ENTRY_END(cmd)
 }
@@ -291,12 +324,11 @@ XrResult XRAPI_CALL SdfgXrSyncActions(XrSession session, const XrActionsSyncInfo
   copy.activeActionSets = active.data();
   const XrResult r = inst.next.xrSyncActions(session, &copy);
   if (r == XR_SUCCESS || r == XR_SESSION_NOT_FOCUSED) {
-    // A failure in the layer's own work never changes the app's result.
+    // A failure in the layer's own work never changes the app's result. Builds the update
+    // records go to a queue of the layer's own at once (the pump in syncGrasps); the app's queue
+    // waits for the frame calls.
     try {
-      std::lock_guard lock(s->mutex);
-      updateGrasps(*s);
-      // A queue of the layer's own takes the new builds at once; the app's waits for the frame.
-      if (s->ownQueue) submitGpuWork(*s, false, cmd);
+      syncGrasps(*s, cmd);
     } catch (...) {
       SDFG_LOG_WARN(cmd, "grab update failed; hands pass through this frame");
     }

@@ -68,9 +68,10 @@ XrResult verifyTargetSettings(const char* cmd, const XrGraspTargetSettingsSDFG* 
 void applyTargetSettings(SessionState& session, uint64_t target,
                          const XrGraspTargetSettingsSDFG* settings);
 
+// target_state.cpp (version 3): xrGetGraspTargetStateSDFG.
+XrResult XRAPI_CALL SdfgXrGetGraspTargetStateSDFG(XrGraspTargetSDFG, XrGraspTargetStateSDFG*);
+
 // input.cpp: creates the layer's action set and actions on a new instance.
 void createLayerActions(InstanceState& instance);
-// hands.cpp: destroys the layer's internal trackers of a session (before it goes away).
-void destroyInternalTrackers(SessionState& session);
 
 }  // namespace sdfg::layer

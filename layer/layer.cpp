@@ -8,7 +8,9 @@
 #include "intercepts.h"
 #include "loader_interfaces.h"
 #include "log.h"
+#include "rollback.h"
 #include "state.h"
+#include "test_fault.h"
 
 namespace sdfg::layer {
 namespace {
@@ -205,8 +207,19 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
                   withMotionRange, int(r));
   }
   if (XR_FAILED(r)) return r;
-  state->handle = *instance;
-  state->next.load(state->nextGipa, *instance);
+  // From here on a failure (the dispatch table, the layer's actions, the map) gives the instance
+  // back: destroyed through the chain below, as the app would.
+  const XrInstance made = *instance;
+  const PFN_xrGetInstanceProcAddr nextGipa = state->nextGipa;
+  Rollback undo([&] {
+    clearDebugUtilsSink(made);
+    PFN_xrVoidFunction destroy = nullptr;
+    if (nextGipa(made, "xrDestroyInstance", &destroy) == XR_SUCCESS && destroy != nullptr)
+      reinterpret_cast<PFN_xrDestroyInstance>(destroy)(made);
+    *instance = XR_NULL_HANDLE;
+  });
+  state->handle = made;
+  state->next.load(state->nextGipa, made);
   // A runtime may list hand tracking for a system that has no hands (Monado with controllers
   // only): then the layer synthesizes them. Asked now, because the routing is fixed when the
   // loader fills its dispatch table right after this call.
@@ -229,7 +242,9 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
                 static_cast<void*>(*instance), state->active ? "active" : "pass-through",
                 state->appAutoGrasp, state->appHandTracking, state->runtimeHandTracking,
                 state->provideHandTracking, bool(state->runtimeSystemLacksHands));
-  instances().insert(key(*instance), std::move(state));
+  throwIfTestFault(*state, "after_create_instance");
+  instances().insert(key(made), std::move(state));
+  undo.dismiss();
   return r;
   SDFG_ENTRY_END(cmd)
 }
@@ -240,16 +255,14 @@ XrResult XRAPI_CALL SdfgXrDestroyInstance(XrInstance instance) {
   auto state = instances().find(key(instance));
   if (state == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(instance) is not valid");
   clearDebugUtilsSink(instance);
-  // Sessions the app did not destroy go with the instance: their GPU work first (waits for
-  // builds in flight), while the app's Vulkan device surely exists.
+  // Sessions the app did not destroy go with the instance: the layer's work on each ends here,
+  // on this thread and under no lock (the map's lock is only held to list them), GPU work first
+  // while the app's Vulkan device surely exists.
   std::vector<std::shared_ptr<SessionState>> own;
   sessions().forEach([&](const std::shared_ptr<SessionState>& s) {
     if (s->instance == state) own.push_back(s);
   });
-  for (const auto& s : own) {
-    std::lock_guard lock(s->mutex);  // not under the map's lock: sessions lock it the other way
-    dropGpuWork(*s);
-  }
+  for (const auto& s : own) endSessionWork(*s);
   const XrResult r = state->next.xrDestroyInstance(instance);
   if (XR_SUCCEEDED(r)) {
     // The instance took its sessions and their children with it.
@@ -350,6 +363,7 @@ const Route kRoutes[] = {
     SDFG_ROUTE(XrGetGraspStateSDFG, Gate::autoGrasp),
     SDFG_ROUTE(XrSetGraspOptionsSDFG, Gate::autoGrasp),
     SDFG_ROUTE(XrSetGraspTargetSettingsSDFG, Gate::autoGrasp),
+    SDFG_ROUTE(XrGetGraspTargetStateSDFG, Gate::autoGrasp),
 };
 
 XrResult XRAPI_CALL SdfgXrGetInstanceProcAddr(XrInstance instance, const char* name,

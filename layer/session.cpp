@@ -4,7 +4,9 @@
 
 #include "intercepts.h"
 #include "log.h"
+#include "rollback.h"
 #include "state.h"
+#include "test_fault.h"
 
 namespace sdfg::layer {
 namespace {
@@ -14,34 +16,87 @@ std::shared_ptr<InstanceState> instanceOf(XrInstance handle) {
 }
 
 // Records a space the app created on `s`, so grasp targets placed in it can be validated and
-// located, and so it is forgotten with its session.
-void rememberSpace(const std::shared_ptr<SessionState>& s, XrSpace space) {
-  std::lock_guard lock(s->mutex);
-  s->spaces.insert(key(space));
-  spaceOwners().insert(key(space), s);
+// located, and so it is forgotten with its session. On failure (out of memory) the runtime's
+// space is destroyed and the exception goes on to the entry point, which returns the error.
+void rememberSpace(const std::shared_ptr<SessionState>& s, XrSpace* space) {
+  const InstanceState& inst = *s->instance;
+  const XrSpace made = *space;
+  Rollback undo([&] {
+    {
+      std::lock_guard lock(s->mutex);
+      s->spaces.erase(key(made));
+    }
+    inst.next.xrDestroySpace(made);
+    *space = XR_NULL_HANDLE;
+  });
+  {
+    std::lock_guard lock(s->mutex);
+    s->spaces[key(made)] = SpaceUse{};
+  }
+  throwIfTestFault(inst, "after_create_space");
+  spaceOwners().insert(key(made), s);
+  undo.dismiss();
 }
 
 // The current time in the runtime's XrTime, for a frame whose predicted display time is 0 (or
 // negative): every grasp needs a time to locate hands and targets at. 0 when the chain offers
-// no conversion; then the layer says once that this session cannot grasp.
-XrTime layerClockTime(SessionState& s, const char* cmd) {
-  InstanceState& inst = *s.instance;
+// no conversion. Calls the runtime: no lock held.
+XrTime layerClockTime(const InstanceState& inst) {
   XrTime t = 0;
   timespec now{};
   if (inst.next.xrConvertTimespecTimeToTimeKHR != nullptr &&
       clock_gettime(CLOCK_MONOTONIC, &now) == 0 &&
       inst.next.xrConvertTimespecTimeToTimeKHR(inst.handle, &now, &t) == XR_SUCCESS && t > 0)
     return t;
-  if (!s.noTimeLogged) {
-    s.noTimeLogged = true;
-    SDFG_LOG_WARN(cmd,
-                  "the runtime predicts no display time and offers no "
-                  "XR_KHR_convert_timespec_time: no grasps in this session");
-  }
   return 0;
 }
 
+// The runtime's xrDestroySpace for a space this layer did not see created (an anchor of an
+// extension it does not know): the next function of the instance that owns it. The layer cannot
+// tell which instance that is; every instance's chain below holds the same function unless their
+// apps enabled different layers, and then it refuses rather than guess.
+XrResult destroyUnknownSpace(XrSpace space, const char* cmd) {
+  PFN_xrDestroySpace next = nullptr;
+  bool ambiguous = false;
+  instances().forEach([&](const std::shared_ptr<InstanceState>& inst) {
+    if (inst->next.xrDestroySpace == nullptr) return;
+    if (next != nullptr && next != inst->next.xrDestroySpace) ambiguous = true;
+    next = inst->next.xrDestroySpace;
+  });
+  if (next == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(space) is not valid");
+  if (ambiguous)
+    return logError(XR_ERROR_HANDLE_INVALID, cmd,
+                    "(space) was not created through this layer, and the instances' chains "
+                    "below it differ: the layer cannot tell which one owns it");
+  return next(space);
+}
+
 }  // namespace
+
+void endSessionWork(SessionState& s) {
+  std::array<XrHandTrackerEXT, 2> internal{};
+  std::unique_ptr<GraspSession> grasp;
+  std::shared_ptr<DeferredMailbox> gpu;
+  {
+    std::lock_guard lock(s.mutex);
+    internal = std::exchange(s.internalTrackers, {});
+    grasp = std::move(s.grasp);
+    gpu = std::move(s.gpu);
+    s.ownQueue = false;
+    s.targets.clear();
+  }
+  for (auto& shown : s.shown) shown.store(nullptr);
+  for (XrHandTrackerEXT t : internal) {
+    if (t != XR_NULL_HANDLE && s.instance->next.xrDestroyHandTrackerEXT != nullptr)
+      s.instance->next.xrDestroyHandTrackerEXT(t);
+  }
+  // The worker stops what it runs within milliseconds and is joined here, on the thread that
+  // destroys the session, holding no lock another call could need.
+  grasp.reset();
+  // Waits for the layer's builds in flight on the app's device and frees the layer's objects
+  // there, while the device surely exists (the app destroys it after the session).
+  if (gpu != nullptr) gpu->shutdown();
+}
 
 XrResult XRAPI_CALL SdfgXrGetSystemProperties(XrInstance instance, XrSystemId systemId,
                                               XrSystemProperties* properties) {
@@ -97,7 +152,14 @@ XrResult XRAPI_CALL SdfgXrCreateSession(XrInstance instance, const XrSessionCrea
   if (state == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(instance) is not valid");
   const XrResult r = state->next.xrCreateSession(instance, info, session);
   if (XR_FAILED(r)) return r;
-  auto s = std::make_shared<SessionState>();
+  // From here on a failure (the worker thread, the GPU path, the map) gives the session back.
+  std::shared_ptr<SessionState> s;
+  Rollback undo([&] {
+    if (s != nullptr) endSessionWork(*s);
+    state->next.xrDestroySession(*session);
+    *session = XR_NULL_HANDLE;
+  });
+  s = std::make_shared<SessionState>();
   s->handle = *session;
   s->instance = state;
   if (const auto* vk = findInChain<const XrGraphicsBindingVulkanKHR>(
@@ -120,8 +182,7 @@ XrResult XRAPI_CALL SdfgXrCreateSession(XrInstance instance, const XrSessionCrea
       state->config.sdfFarBand * std::max(spacing.x, std::max(spacing.y, spacing.z));
   // CPU builds, target set-ups and solves run on the session's worker thread, never inside the
   // app's calls; its builder uses that one thread (an app on a 2-core machine keeps the other).
-  s->grasp = std::make_unique<GraspSession>(makeCpuSdfBackend(1, cpuOptions), std::move(gpu),
-                                            GraspThreading::worker);
+  s->grasp = std::make_unique<GraspSession>(makeCpuSdfBackend(1, cpuOptions), std::move(gpu));
   s->grasp->setDeferredForMeshTargets(s->gpuForArrayTargets);
   if (Status st = s->grasp->configure(s->settings); st != Status::ok) {
     SDFG_LOG_WARN(cmd, "configured solver '%s' is not usable (%s); using 'paper'",
@@ -129,7 +190,9 @@ XrResult XRAPI_CALL SdfgXrCreateSession(XrInstance instance, const XrSessionCrea
     s->settings.solver = "paper";
     (void)s->grasp->configure(s->settings);
   }
-  sessions().insert(key(*session), std::move(s));
+  throwIfTestFault(*state, "after_create_session");
+  sessions().insert(key(*session), s);
+  undo.dismiss();
   return r;
   SDFG_ENTRY_END(cmd)
 }
@@ -139,24 +202,23 @@ XrResult XRAPI_CALL SdfgXrDestroySession(XrSession session) {
   SDFG_ENTRY_BEGIN
   auto s = sessions().find(key(session));
   if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
-  {
-    std::lock_guard lock(s->mutex);
-    destroyInternalTrackers(*s);
-    // GPU work first: waits for builds in flight and frees the layer's objects on the app's
-    // device while it surely exists (the app destroys it after the session).
-    dropGpuWork(*s);
-  }
+  // The layer's work ends first, here and with no lock held (docs/threading.md: within tens of
+  // milliseconds, plus the wait for the layer's GPU builds in flight); nothing of the layer runs
+  // for this session after this call.
+  endSessionWork(*s);
   const XrResult r = s->instance->next.xrDestroySession(session);
   if (XR_SUCCEEDED(r)) {
     // Children go with the session: its trackers, targets and spaces.
     trackers().eraseIf([&](const TrackerState& t) { return t.session.lock() == s; });
     targets().eraseIf([&](const TargetState& t) { return t.session.lock() == s; });
     spaceOwners().eraseIf([&](const SessionState& owner) { return &owner == s.get(); });
-    std::lock_guard lock(s->mutex);
-    s->targets.clear();
-    s->grasp.reset();
     sessions().erase(key(session));
     s->instance->events.dropSession(session);  // its grasp events would name a dead handle
+  } else {
+    SDFG_LOG_WARN(cmd,
+                  "the runtime refused to destroy the session (%d); the layer no longer "
+                  "grasps in it",
+                  int(r));
   }
   return r;
   SDFG_ENTRY_END(cmd)
@@ -172,11 +234,22 @@ XrResult XRAPI_CALL SdfgXrWaitFrame(XrSession session, const XrFrameWaitInfo* in
   if (XR_SUCCEEDED(r) && frameState != nullptr) {
     // The layer's own work never changes the app's result.
     try {
-      std::lock_guard lock(s->mutex);
-      s->predictedTime = frameState->predictedDisplayTime;
-      if (s->predictedTime <= 0) s->predictedTime = layerClockTime(*s, cmd);
-      selfAttachIfNeeded(*s);
-      if (s->selfAttached) syncOwnActions(*s);
+      XrTime time = frameState->predictedDisplayTime;
+      if (time <= 0) time = layerClockTime(*s->instance);
+      bool sayNoTime = false;
+      bool selfAttached = false;
+      {
+        std::lock_guard lock(s->mutex);
+        s->predictedTime = time;
+        sayNoTime = time <= 0 && !std::exchange(s->noTimeLogged, true);
+        selfAttached = s->selfAttached;
+      }
+      if (sayNoTime)
+        SDFG_LOG_WARN(cmd,
+                      "the runtime predicts no display time and offers no "
+                      "XR_KHR_convert_timespec_time: no grasps in this session");
+      if (!selfAttached) selfAttachIfNeeded(*s);
+      syncOwnActions(*s);
     } catch (...) {
       SDFG_LOG_WARN(cmd, "frame update failed; hands pass through this frame");
     }
@@ -193,7 +266,7 @@ XrResult XRAPI_CALL SdfgXrCreateReferenceSpace(XrSession session,
   auto s = sessions().find(key(session));
   if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
   const XrResult r = s->instance->next.xrCreateReferenceSpace(session, info, space);
-  if (XR_SUCCEEDED(r)) rememberSpace(s, *space);
+  if (XR_SUCCEEDED(r)) rememberSpace(s, space);
   return r;
   SDFG_ENTRY_END(cmd)
 }
@@ -205,7 +278,7 @@ XrResult XRAPI_CALL SdfgXrCreateActionSpace(XrSession session, const XrActionSpa
   auto s = sessions().find(key(session));
   if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
   const XrResult r = s->instance->next.xrCreateActionSpace(session, info, space);
-  if (XR_SUCCEEDED(r)) rememberSpace(s, *space);
+  if (XR_SUCCEEDED(r)) rememberSpace(s, space);
   return r;
   SDFG_ENTRY_END(cmd)
 }
@@ -214,18 +287,55 @@ XrResult XRAPI_CALL SdfgXrDestroySpace(XrSpace space) {
   constexpr const char* cmd = "xrDestroySpace";
   SDFG_ENTRY_BEGIN
   auto s = spaceOwners().find(key(space));
-  if (s == nullptr) {
-    // A space this layer did not see created (an anchor of another extension): pass it down.
-    auto any = instances().any();
-    if (any == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(space) is not valid");
-    return any->next.xrDestroySpace(space);
+  if (s == nullptr) return destroyUnknownSpace(space, cmd);
+  // No new use of the space starts once it is dying; this call waits for the uses in flight (a
+  // grab update on another thread locating a target placed in it: one xrLocateSpace), so the
+  // layer never passes the space down after the app destroyed it. Targets placed in it stop
+  // taking part until they are placed again, and a hand holding one lets go.
+  std::vector<uint64_t> unplaced;
+  {
+    std::unique_lock lock(s->mutex);
+    auto use = s->spaces.find(key(space));
+    if (use != s->spaces.end()) {
+      use->second.dying = true;
+      s->spaceReleased.wait(lock, [&] {
+        auto u = s->spaces.find(key(space));
+        return u == s->spaces.end() || u->second.users == 0;
+      });
+    }
+    for (const auto& [id, t] : s->targets) {
+      if (!t->placed || t->space != space) continue;
+      t->placed = false;
+      t->space = XR_NULL_HANDLE;
+      unplaced.push_back(id);
+    }
+    if (s->grasp != nullptr) {
+      for (Hand hand : {Hand::left, Hand::right}) {
+        const HandGrasp& g = s->grasp->grasp(hand);
+        if (!g.holding || std::find(unplaced.begin(), unplaced.end(), g.target) == unplaced.end())
+          continue;
+        const bool wasGrasping = g.shown();
+        const uint64_t wasTarget = g.target;
+        s->grasp->release(hand);
+        noteGraspChange(*s, hand, wasGrasping, wasTarget);
+      }
+      publishShownHands(*s);
+    }
   }
+  if (!unplaced.empty())
+    SDFG_LOG_INFO(cmd,
+                  "%zu grasp target(s) were placed in this space; they take no part until placed "
+                  "again",
+                  unplaced.size());
   const XrResult r = s->instance->next.xrDestroySpace(space);
-  if (XR_SUCCEEDED(r)) {
+  {
     std::lock_guard lock(s->mutex);
-    s->spaces.erase(key(space));
-    spaceOwners().erase(key(space));
+    if (XR_SUCCEEDED(r))
+      s->spaces.erase(key(space));
+    else if (auto use = s->spaces.find(key(space)); use != s->spaces.end())
+      use->second.dying = false;  // still alive: it may be used again (its targets stay unplaced)
   }
+  if (XR_SUCCEEDED(r)) spaceOwners().erase(key(space));
   return r;
   SDFG_ENTRY_END(cmd)
 }

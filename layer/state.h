@@ -2,11 +2,17 @@
 // mutexes. Lookups on app input return null for an unknown handle; the caller answers
 // XR_ERROR_HANDLE_INVALID. Objects are shared_ptr so a call in flight keeps what it uses alive
 // while another thread destroys the handle.
+//
+// Locks (docs/threading.md): none is ever held across a call into the runtime, into Vulkan or
+// into the layer's log (whose debug-utils sink calls the runtime). A call gathers what it needs
+// from the runtime first, locks only to hand it over, and publishes what other threads read.
 #pragma once
 
 #include <array>
 #include <atomic>
+#include <condition_variable>
 #include <cstring>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -17,13 +23,12 @@
 #include "dispatch.h"
 #include "events.h"
 #include "grasp/grasp_session.h"
+#include "grasp/shown_hand.h"
 #include "hand/hand_synthesis.h"
 #include "hand_offset.h"
+#include "published.h"
+#include "sdf/deferred_mailbox.h"
 #include "xr_includes.h"
-
-namespace sdfg {
-class VkGraspBackend;
-}
 
 namespace sdfg::layer {
 
@@ -95,7 +100,7 @@ struct InstanceState {
   XrAction gripAction = XR_NULL_HANDLE;
   std::array<XrPath, 2> handPaths{};
   std::vector<ProfilePaths> profiles;     // resolved when the actions are created
-  std::mutex inputMutex;                  // guards the fields below
+  std::mutex inputMutex;                  // guards the fields below (never across a call down)
   std::set<XrPath> appSuggestedProfiles;  // profiles the app suggested bindings for
 
   // XR_KHR_vulkan_enable2: what the app's xrCreateVulkanInstanceKHR / xrCreateVulkanDeviceKHR
@@ -116,23 +121,37 @@ struct InstanceState {
 
 struct TargetState;
 
+// A reference or action space the app created on a session, as the layer tracks it.
+struct SpaceUse {
+  int users = 0;       // the layer's calls that pass it down right now (xrLocateSpace)
+  bool dying = false;  // xrDestroySpace is under way: no new use may start
+};
+
 struct SessionState {
   XrSession handle = XR_NULL_HANDLE;
   std::shared_ptr<InstanceState> instance;
   bool vulkan = false;  // created with a Vulkan binding
   XrGraphicsBindingVulkanKHR vulkanBinding{};
 
-  std::mutex mutex;           // guards everything below
-  std::set<uint64_t> spaces;  // reference and action spaces the app created on this session
-  bool attached = false;      // the layer's action set is attached with the app's
+  // Guards everything below but `shown`. Held for copies and the engine's bookkeeping
+  // (microseconds), never across a call into the runtime, Vulkan or the log.
+  std::mutex mutex;
+  // The spaces the app created on this session. xrDestroySpace marks one dying and waits on
+  // `spaceReleased` until no call of the layer uses it any more, then passes the destroy down:
+  // the layer never hands a destroyed space to the runtime.
+  std::map<uint64_t, SpaceUse> spaces;
+  std::condition_variable spaceReleased;
+  bool attached = false;  // the layer's action set is attached with the app's
   // The app attached no action sets but located synthesized hands: the layer attached its set
   // alone (input.cpp selfAttachIfNeeded) and syncs it in xrWaitFrame; tried once.
   bool selfAttached = false;
+  bool selfAttaching = false;  // a thread is attaching it now (without the lock)
   bool selfAttachFailed = false;
   bool appAttached = false;     // the app's own sets are attached (with or without the layer's)
   int synthesizedTrackers = 0;  // live synthesized trackers the app made on this session
   // The runtime refused the layer's own hand tracker for a hand: remembered, never retried.
   std::array<bool, 2> internalTrackerRefused{};
+  std::array<bool, 2> internalTrackerCreating{};  // a thread is asking the runtime for one now
   // Said once: the runtime's display time is unusable and the layer cannot convert one.
   bool noTimeLogged = false;
   std::array<XrSpace, 2> gripSpaces{};
@@ -143,14 +162,20 @@ struct SessionState {
   std::array<float, 2> squeeze{};
   std::array<XrHandTrackerEXT, 2> internalTrackers{};  // the layer's own, on the runtime
   std::unique_ptr<GraspSession> grasp;
-  // The Vulkan backend inside `grasp` (null: CPU only), and whether it has a queue of its own.
-  VkGraspBackend* vulkanBackend = nullptr;
+  // The Vulkan backend behind its mailbox (null: CPU only): the engine records builds on it
+  // under `mutex`, pumpGpu() does the device calls with no lock held. Whether it has a queue of
+  // its own.
+  std::shared_ptr<DeferredMailbox> gpu;
   bool ownQueue = false;
   // Array targets build on the device too (config gpu, device type); see makeVulkanBackend().
   bool gpuForArrayTargets = false;
   GraspSettings settings;
   std::unordered_map<uint64_t, std::shared_ptr<TargetState>> targets;
   HandOffsets offsets;  // the hands' offsets off their tracked poses (hand_offset.h)
+
+  // What each hand shows as of the last grab update (left, right): xrLocateHandJointsEXT draws
+  // it without taking `mutex`, so a render thread never waits for the main thread's update.
+  std::array<Published<ShownHand>, 2> shown;
 };
 
 struct TrackerState {
@@ -166,19 +191,26 @@ struct TrackerState {
 struct TargetState {
   uint64_t handle = 0;
   std::weak_ptr<SessionState> session;
+  // Its placement (guarded by the session's mutex). `placed` is false once the app destroyed
+  // `space`: the target takes no part (it is never located, a hand holding it lets go) until
+  // xrSetGraspTargetPlacementSDFG places it again; xrGetGraspTargetStateSDFG says so.
   XrSpace space = XR_NULL_HANDLE;
   XrPosef pose{};
+  bool placed = true;
   uint32_t vertexCount = 0;
   uint32_t indexCount = 0;
   bool deviceBuffers = false;  // the mesh is the app's Vulkan buffers
 };
 
+// A handle-keyed map behind a mutex. No value is destroyed while the mutex is held: the last
+// reference to a session may end its worker, which must not happen under a lock every call
+// takes.
 template <class T>
 class HandleMap {
  public:
   void insert(uint64_t handle, std::shared_ptr<T> value) {
     std::lock_guard lock(mutex_);
-    map_[handle] = std::move(value);
+    map_[handle].swap(value);  // a value it replaces goes with `value`, after the unlock
   }
   std::shared_ptr<T> find(uint64_t handle) const {
     std::lock_guard lock(mutex_);
@@ -205,8 +237,16 @@ class HandleMap {
   }
   template <class Pred>
   void eraseIf(Pred pred) {
+    std::vector<std::shared_ptr<T>> erased;  // released after the unlock
     std::lock_guard lock(mutex_);
-    std::erase_if(map_, [&](const auto& kv) { return pred(*kv.second); });
+    for (auto it = map_.begin(); it != map_.end();) {
+      if (pred(*it->second)) {
+        erased.push_back(std::move(it->second));
+        it = map_.erase(it);
+      } else {
+        ++it;
+      }
+    }
   }
 
  private:
@@ -285,25 +325,36 @@ T* findInChain(Base* chain, XrStructureType type) {
 GraspSettings settingsFromConfig(const Config& config);
 std::string resolveSolverName(const std::string& name);
 
-// Runs the layer's grab update for both hands after the app's xrSyncActions.
-void updateGrasps(SessionState& session);
+// grasp_frame.cpp: the layer's grab update for both hands after a sync of its action set (the
+// app's xrSyncActions, or xrWaitFrame for a session the layer attached alone): gathers the
+// squeeze and the hand and target poses from the runtime with no lock held, then hands them to
+// the engine under the session's lock and publishes what each hand shows. Takes no lock on
+// entry.
+void syncGrasps(SessionState& session, const char* cmd);
+// Publishes what each hand shows now (the caller holds session.mutex): after each grab update,
+// and when a call lets a hand go at once (its target or the target's space destroyed).
+void publishShownHands(SessionState& session);
 // input.cpp, for a session whose app attached no action sets but made synthesized trackers:
-// attaches the layer's set alone (once), and syncs it plus the grab update each frame. The
-// caller holds session.mutex.
+// attaches the layer's set alone (once), and syncs it plus the grab update each frame. Both
+// take no lock on entry.
 void selfAttachIfNeeded(SessionState& session);
 void syncOwnActions(SessionState& session);
 
 // vulkan.cpp: the Vulkan SDF backend for a session created with a Vulkan binding (null when the
 // layer is built without it, the config says gpu = false, or the device cannot be used; the
-// reason is logged). Sets session.vulkanBackend and session.ownQueue.
+// reason is logged): the engine's side of its mailbox. Sets session.gpu and session.ownQueue.
 std::unique_ptr<DeferredSdfBackend> makeVulkanBackend(SessionState& session);
-// Hands the session's recorded GPU builds to the device: `inFrame` inside xrBeginFrame /
-// xrEndFrame (the app's queue is free), else only builds for the layer's own queue. Holds no
-// lock: the caller holds session.mutex.
-void submitGpuWork(SessionState& session, bool inFrame, const char* cmd);
-// Ends the session's GPU path: waits (bounded) for builds in flight and frees the layer's Vulkan
-// objects; the session continues on the CPU. The caller holds session.mutex.
-void dropGpuWork(SessionState& session);
+// Does the session's GPU calls (DeferredMailbox::pump): `inFrame` inside xrBeginFrame /
+// xrEndFrame (the app's queue is free), else only builds for the layer's own queue. Takes no
+// lock on entry, and none across the device calls; a pump running on another thread is not
+// waited for.
+void pumpGpu(SessionState& session, bool inFrame);
+
+// session.cpp: ends the layer's work on a session, on the calling thread and with no lock held:
+// its trackers on the runtime, its worker (stopped and joined: docs/threading.md gives the
+// bound), its GPU path (waits for the layer's builds in flight, then frees its objects on the
+// app's device). Calls after it find no engine and pass through.
+void endSessionWork(SessionState& session);
 
 }  // namespace sdfg::layer
 

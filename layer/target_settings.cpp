@@ -40,10 +40,13 @@ XrResult XRAPI_CALL SdfgXrSetGraspTargetSettingsSDFG(XrGraspTargetSDFG target,
     return logError(XR_ERROR_VALIDATION_FAILURE, cmd, "(settings->type) is %d",
                     int(settings->type));
   if (XrResult r = verifyTargetSettings(cmd, settings); r != XR_SUCCESS) return r;
-  std::lock_guard lock(s->mutex);
-  if (s->grasp == nullptr)
-    return logError(XR_ERROR_SESSION_LOST, cmd, "the session is being destroyed");
-  applyTargetSettings(*s, t->handle, settings);
+  bool lost = false;
+  {
+    std::lock_guard lock(s->mutex);
+    lost = s->grasp == nullptr;
+    if (!lost) applyTargetSettings(*s, t->handle, settings);
+  }
+  if (lost) return logError(XR_ERROR_SESSION_LOST, cmd, "the session is being destroyed");
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)
 }

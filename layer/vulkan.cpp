@@ -64,7 +64,7 @@ VkGraspFault faultFromConfig(const std::string& name) {
 
 std::unique_ptr<DeferredSdfBackend> makeVulkanBackend(SessionState& s) {
   constexpr const char* cmd = "xrCreateSession";
-  s.vulkanBackend = nullptr;
+  s.gpu = nullptr;
   s.ownQueue = false;
   s.gpuForArrayTargets = false;
   if (!s.vulkan) return nullptr;
@@ -109,7 +109,6 @@ std::unique_ptr<DeferredSdfBackend> makeVulkanBackend(SessionState& s) {
     return nullptr;
   }
   (*backend)->injectFault(faultFromConfig(inst.config.testGpuFault));
-  s.vulkanBackend = backend->get();
   s.ownQueue = own.has_value();
   // A CPU implementation of Vulkan runs our compute passes on the cores the CPU builder would
   // use, several times slower (docs/benchmarks-vulkan.md): with gpu = auto only targets that
@@ -125,23 +124,25 @@ std::unique_ptr<DeferredSdfBackend> makeVulkanBackend(SessionState& s) {
       s.gpuForArrayTargets ? "every target" : "buffer targets only (gpu = auto, CPU device)",
       props.deviceName,
       s.ownQueue ? "the layer's own queue" : "the app's queue inside frame calls");
-  return std::move(backend.value());
+  // The engine records builds through the mailbox under the session's lock; pumpGpu() makes the
+  // device calls with no lock held.
+  s.gpu = std::make_shared<DeferredMailbox>(std::move(backend.value()));
+  return DeferredMailbox::ownerSide(s.gpu);
 #else
   SDFG_LOG_INFO(cmd, "built without the Vulkan backend: grab-box SDFs on the CPU");
   return nullptr;
 #endif
 }
 
-void submitGpuWork(SessionState& s, bool inFrame, const char* cmd) {
-  if (s.vulkanBackend == nullptr || s.grasp == nullptr || !s.grasp->needsSubmit(inFrame)) return;
-  if (s.grasp->submitDeferred(inFrame) != Status::ok)
-    SDFG_LOG_WARN(cmd, "GPU submission failed; this session builds on the CPU from now on");
-}
-
-void dropGpuWork(SessionState& s) {
-  s.vulkanBackend = nullptr;
-  s.ownQueue = false;
-  if (s.grasp != nullptr) s.grasp->dropDeferred();
+void pumpGpu(SessionState& s, bool inFrame) {
+  std::shared_ptr<DeferredMailbox> gpu;
+  {
+    std::lock_guard lock(s.mutex);
+    gpu = s.gpu;
+  }
+  // A pump on another thread is not waited for: it, or the next, does the work. A device
+  // failure is the backend's to log (once) and shows in the engine as failed (CPU from then on).
+  if (gpu != nullptr) (void)gpu->pump(inFrame);
 }
 
 namespace {
@@ -149,12 +150,15 @@ namespace {
 // xrBeginFrame and xrEndFrame: the app holds its queue for the runtime during these calls, so
 // pending builds may go on it before the call goes down.
 template <typename Info, typename Next>
-XrResult submitThenCallDown(const char* cmd, XrSession session, const Info* info, Next next) {
+XrResult pumpThenCallDown(const char* cmd, XrSession session, const Info* info, Next next) {
   auto s = sessions().find(key(session));
   if (s == nullptr) return logError(XR_ERROR_HANDLE_INVALID, cmd, "(session) is not valid");
   if (s->vulkan) {
-    std::lock_guard lock(s->mutex);
-    submitGpuWork(*s, true, cmd);
+    try {
+      pumpGpu(*s, true);
+    } catch (...) {
+      SDFG_LOG_WARN(cmd, "GPU submission failed; the call goes down as the app made it");
+    }
   }
   return (s->instance->next.*next)(session, info);
 }
@@ -164,14 +168,14 @@ XrResult submitThenCallDown(const char* cmd, XrSession session, const Info* info
 XrResult XRAPI_CALL SdfgXrBeginFrame(XrSession session, const XrFrameBeginInfo* info) {
   constexpr const char* cmd = "xrBeginFrame";
   SDFG_ENTRY_BEGIN
-  return submitThenCallDown(cmd, session, info, &NextDispatch::xrBeginFrame);
+  return pumpThenCallDown(cmd, session, info, &NextDispatch::xrBeginFrame);
   SDFG_ENTRY_END(cmd)
 }
 
 XrResult XRAPI_CALL SdfgXrEndFrame(XrSession session, const XrFrameEndInfo* info) {
   constexpr const char* cmd = "xrEndFrame";
   SDFG_ENTRY_BEGIN
-  return submitThenCallDown(cmd, session, info, &NextDispatch::xrEndFrame);
+  return pumpThenCallDown(cmd, session, info, &NextDispatch::xrEndFrame);
   SDFG_ENTRY_END(cmd)
 }
 
@@ -231,8 +235,14 @@ XrResult XRAPI_CALL SdfgXrCreateVulkanDeviceKHR(XrInstance instance,
       copy.vulkanCreateInfo = &dci;
       const XrResult r = next(instance, &copy, device, vulkanResult);
       if (XR_SUCCEEDED(r) && *vulkanResult == VK_SUCCESS) {
-        std::lock_guard lock(state->vulkanMutex);
-        state->extraQueues[key(*device)] = {plan.family, plan.index};
+        try {
+          std::lock_guard lock(state->vulkanMutex);
+          state->extraQueues[key(*device)] = {plan.family, plan.index};
+        } catch (...) {
+          // The app's device is fine as it is: the layer only does without its queue.
+          SDFG_LOG_WARN(cmd, "could not record the layer's queue; the layer does without it");
+          return r;
+        }
         SDFG_LOG_INFO(cmd, "added queue %u of family %u for the layer", plan.index, plan.family);
         return r;
       }

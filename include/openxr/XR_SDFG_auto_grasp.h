@@ -40,7 +40,7 @@ extern "C" {
 #endif
 
 #define XR_SDFG_auto_grasp 1
-#define XR_SDFG_auto_grasp_SPEC_VERSION 2
+#define XR_SDFG_auto_grasp_SPEC_VERSION 3
 #define XR_SDFG_AUTO_GRASP_EXTENSION_NAME "XR_SDFG_auto_grasp"
 
 XR_DEFINE_HANDLE(XrGraspTargetSDFG)
@@ -90,8 +90,8 @@ typedef struct XrGraspTargetPlacementSDFG {
 // outside, and while it sets the target up (off the app's thread) it detects each connected
 // part's orientation (signed volume when the part is closed, the generalized winding number when
 // it is open, after making neighbouring triangles consistent) and flips inside-out or mixed parts
-// on its own copy; it logs what it found once per target. A flat open sheet is taken as given. (Vulkan-buffer targets below are
-// not inspected: wind them counter-clockwise.)
+// on its own copy; it logs what it found once per target. A flat open sheet is taken as given.
+// (Vulkan-buffer targets below are not inspected: wind them counter-clockwise.)
 typedef struct XrGraspTargetVerticesSDFG {
   XrStructureType type;  // XR_TYPE_GRASP_TARGET_VERTICES_SDFG
   const void* XR_MAY_ALIAS next;
@@ -452,6 +452,35 @@ typedef struct XrGraspClearanceOptionsSDFG {
   float approachMaxAngle;       // radians, 0 or (0, pi]: palms turned farther are left
   float blendTime;              // seconds, 0 or (0, 2]: the offset's blend in and out
 } XrGraspClearanceOptionsSDFG;
+
+// ---------------------------------------------------------------------------------------------
+// Version 3, a target's own state: whether it is placed.
+//
+// Every version 1 and 2 struct keeps its layout; version 1 and 2 apps run unchanged (what a
+// destroyed space does to the targets placed in it, below, holds for them too). Structure type
+// values of this part: 1009900060..1009900069.
+// ---------------------------------------------------------------------------------------------
+
+#define XR_TYPE_GRASP_TARGET_STATE_SDFG ((XrStructureType)1009900060)
+
+// Output: the state of one target.
+// A target is placed by xrCreateGraspTargetSDFG and xrSetGraspTargetPlacementSDFG. When the app
+// destroys the space it is placed in (xrDestroySpace), it is no longer placed: the layer never
+// locates it again (it never passes the destroyed space to the runtime), no hand grabs it, and a
+// hand holding it lets go at once (an XrEventDataGraspChangedSDFG with
+// XR_GRASP_CHANGE_REASON_RELEASED_SDFG). It keeps its mesh and settings, and takes part again from
+// the next xrSyncActions after xrSetGraspTargetPlacementSDFG places it in a live space.
+typedef struct XrGraspTargetStateSDFG {
+  XrStructureType type;  // XR_TYPE_GRASP_TARGET_STATE_SDFG
+  void* XR_MAY_ALIAS next;
+  XrBool32 isPlaced;  // XR_FALSE: its space was destroyed; it takes no part until placed again
+} XrGraspTargetStateSDFG;
+
+// Fills `state` for `target`. Errors: XR_ERROR_HANDLE_INVALID (target),
+// XR_ERROR_VALIDATION_FAILURE (state null or of the wrong `type`, a chain too long),
+// XR_ERROR_RUNTIME_FAILURE; `state` is not written then.
+typedef XrResult(XRAPI_PTR* PFN_xrGetGraspTargetStateSDFG)(XrGraspTargetSDFG target,
+                                                           XrGraspTargetStateSDFG* state);
 
 #ifdef __cplusplus
 }

@@ -1,13 +1,103 @@
-// The layer's configuration keys (layer/config.h): each value is parsed or refused, and a
-// refused value leaves the whole configuration as it was.
+// The layer's configuration keys (layer/config.h): every key takes a good value into its field
+// and refuses a bad one, and a refused value leaves the whole configuration as it was.
 #include <catch2/catch.hpp>
+
+#include <cctype>
+#include <cstdlib>
+#include <string>
 
 #include "config.h"
 
 using sdfg::layer::applyConfigValue;
 using sdfg::layer::Config;
+using sdfg::layer::LogLevel;
 
-TEST_CASE("gpu takes auto, on and off (and booleans); anything else changes nothing",
+namespace {
+
+// Field by field: a refused value must leave every one as it was.
+bool sameConfig(const Config& a, const Config& b) {
+  return a.logLevel == b.logLevel && a.solver == b.solver && a.grabThreshold == b.grabThreshold &&
+         a.releaseRatio == b.releaseRatio && a.resolution == b.resolution &&
+         a.curlStep == b.curlStep && a.exactCheck == b.exactCheck &&
+         a.buildTimeLimitMs == b.buildTimeLimitMs && a.sdfFarBand == b.sdfFarBand &&
+         a.synthesis == b.synthesis && a.gpu == b.gpu && a.extraQueue == b.extraQueue &&
+         a.testGpuFault == b.testGpuFault && a.testLayerFault == b.testLayerFault &&
+         a.configPath == b.configPath && a.clearHand == b.clearHand &&
+         a.clearBound == b.clearBound && a.approach == b.approach &&
+         a.approachRange == b.approachRange && a.approachMaxAngle == b.approachMaxAngle &&
+         a.offsetBlendTime == b.offsetBlendTime;
+}
+
+struct KeyCase {
+  const char* key;
+  const char* good;
+  bool (*took)(const Config&);  // the good value is in its field
+  const char* bad;
+};
+
+// Every key of the configuration (docs/layer.md, "Configuration"), a value it takes and one it
+// refuses.
+const KeyCase kKeys[] = {
+    {"log_level", "debug", [](const Config& c) { return c.logLevel == LogLevel::debug; }, "loud"},
+    {"solver", "paper", [](const Config& c) { return c.solver == "paper"; }, ""},
+    {"grab_threshold", "0.5", [](const Config& c) { return c.grabThreshold == 0.5f; }, "0"},
+    {"release_ratio", "0.5", [](const Config& c) { return c.releaseRatio == 0.5f; }, "1.5"},
+    {"resolution", "32", [](const Config& c) { return c.resolution == 32u; }, "33.5"},
+    {"curl_step", "0.05", [](const Config& c) { return c.curlStep == 0.05f; }, "0"},
+    {"exact_check", "off", [](const Config& c) { return !c.exactCheck; }, "maybe"},
+    {"sdf_far_band", "3", [](const Config& c) { return c.sdfFarBand == 3.0f; }, "-1"},
+    {"synthesis", "off", [](const Config& c) { return !c.synthesis; }, "perhaps"},
+    {"gpu", "off", [](const Config& c) { return c.gpu == Config::Gpu::off; }, "sometimes"},
+    {"extra_queue", "off", [](const Config& c) { return !c.extraQueue; }, "2"},
+    {"test_gpu_fault", "lost_at_poll",
+     [](const Config& c) { return c.testGpuFault == "lost_at_poll"; }, "crash"},
+    {"test_layer_fault", "after_create_session",
+     [](const Config& c) { return c.testLayerFault == "after_create_session"; }, "after_lunch"},
+    {"clear_hand", "off", [](const Config& c) { return !c.clearHand; }, "x"},
+    {"clear_bound", "0.05", [](const Config& c) { return c.clearBound == 0.05f; }, "0.3"},
+    {"approach", "on", [](const Config& c) { return c.approach; }, "x"},
+    {"approach_range", "0.05", [](const Config& c) { return c.approachRange == 0.05f; }, "0"},
+    {"approach_max_angle", "45", [](const Config& c) { return c.approachMaxAngle == 45.0f; },
+     "200"},
+    {"offset_blend_time", "0.5", [](const Config& c) { return c.offsetBlendTime == 0.5f; }, "3"},
+    {"build_time_limit_ms", "250", [](const Config& c) { return c.buildTimeLimitMs == 250u; }, "0"},
+};
+
+}  // namespace
+
+TEST_CASE("Every key takes a good value into its field and refuses a bad one, changing nothing",
+          "[layer][config]") {
+  for (const KeyCase& k : kKeys) {
+    CAPTURE(k.key, k.good, k.bad);
+    const Config defaults;
+    Config c;
+    CHECK_FALSE(k.took(c));  // the good value is not the default: taking it shows
+    REQUIRE(applyConfigValue(c, k.key, k.good));
+    CHECK(k.took(c));
+    const Config taken = c;
+    CHECK_FALSE(applyConfigValue(c, k.key, k.bad));
+    CHECK(sameConfig(c, taken));
+    // And the bad value alone, from the defaults, changes nothing either.
+    Config fresh;
+    CHECK_FALSE(applyConfigValue(fresh, k.key, k.bad));
+    CHECK(sameConfig(fresh, defaults));
+  }
+}
+
+TEST_CASE("Every key is read from its SDFG_AUTOGRASP_ environment variable", "[layer][config]") {
+  // No config file: XDG_CONFIG_HOME points where there is none.
+  setenv("XDG_CONFIG_HOME", "/nonexistent-sdfg-config", 1);
+  for (const KeyCase& k : kKeys) {
+    std::string name = "SDFG_AUTOGRASP_";
+    for (const char* p = k.key; *p != '\0'; ++p) name += char(std::toupper(*p));
+    CAPTURE(name, k.good);
+    setenv(name.c_str(), k.good, 1);
+    CHECK(k.took(sdfg::layer::loadConfig()));
+    unsetenv(name.c_str());
+  }
+}
+
+TEST_CASE("gpu takes auto, on and off (and booleans), and anything else changes nothing",
           "[layer][config]") {
   Config c;
   CHECK(c.gpu == Config::Gpu::automatic);

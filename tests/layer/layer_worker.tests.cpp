@@ -99,10 +99,13 @@ TEST_CASE("Destroying a target or the session while the worker sets it up is saf
   CHECK(ext.destroy(first) == XR_ERROR_HANDLE_INVALID);
   makeTarget(app, ext, big, {{0, 0, 0, 1}, centre});
   app.frames(2);  // the squeeze is on: the frames ask for a grab of a target not ready yet
+  REQUIRE(setupInfo(app, ext).pendingCount == 1);  // the second set-up has not finished
   const auto start = std::chrono::steady_clock::now();
   app.destroySession();
-  // The worker is joined inside xrDestroySession: it ends after the set-up it is running.
-  CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(30));
+  // The worker is joined inside xrDestroySession, its set-up stopped: the call returns within the
+  // bound docs/threading.md states (tens of milliseconds; a second allowed for a loaded machine
+  // under the sanitizers), not after the set-up.
+  CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(1));
   CHECK(validationLog().empty());
 }
 

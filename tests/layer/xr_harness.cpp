@@ -91,10 +91,14 @@ std::string applyEnv(const XrEnv& env) {
   } else {
     unsetenv("SDFG_MOCK_SCRIPT");
   }
-  // Layer settings a previous test may have set.
-  unsetenv("SDFG_AUTOGRASP_GPU");
-  unsetenv("SDFG_AUTOGRASP_EXTRA_QUEUE");
-  unsetenv("SDFG_AUTOGRASP_TEST_GPU_FAULT");
+  // Layer settings a previous test of the process may have set: every SDFG_AUTOGRASP_ variable.
+  std::vector<std::string> settings;
+  for (char** e = environ; *e != nullptr; ++e) {
+    const std::string entry = *e;
+    if (entry.rfind("SDFG_AUTOGRASP_", 0) == 0)
+      settings.push_back(entry.substr(0, entry.find('=')));
+  }
+  for (const std::string& name : settings) unsetenv(name.c_str());
   for (const auto& [k, v] : env.extra) setenv(k.c_str(), v.c_str(), 1);
   return cv;
 }

@@ -1,11 +1,13 @@
 // The runtime's only exported symbol (loader negotiation), xrGetInstanceProcAddr, the handle
 // table and the error helper. Every command goes through Entry: one global lock and a
 // catch-all, so no exception crosses the C ABI.
+#include <chrono>
 #include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <new>
+#include <thread>
 
 #include "entry_points.h"
 
@@ -27,8 +29,13 @@ struct Entry;
 
 template <class... A, XrResult (*Impl)(A...)>
 struct Entry<Impl> {
+  static CallGate& gate() {
+    static CallGate g;
+    return g;
+  }
   static XrResult XRAPI_CALL call(A... args) noexcept {
     try {
+      gate().pass();  // before the lock: a held call does not hold up the other commands
       std::lock_guard<std::mutex> lock(globalMutex());
       return Impl(args...);
     } catch (const std::bad_alloc&) {
@@ -46,13 +53,15 @@ struct Command {
   const char* name;
   PFN_xrVoidFunction function;
   Needs needs;
+  CallGate* gate;
 };
 
 XrResult getInstanceProcAddr(XrInstance instance, const char* name, PFN_xrVoidFunction* function);
 
-#define MOCK_COMMAND(xrName, impl, needs)                                               \
-  Command {                                                                             \
-#xrName, reinterpret_cast < PFN_xrVoidFunction>(&Entry <&impl>::call), Needs::needs \
+#define MOCK_COMMAND(xrName, impl, needs)                                                \
+  Command {                                                                              \
+#xrName, reinterpret_cast < PFN_xrVoidFunction>(&Entry <&impl>::call), Needs::needs, \
+        &Entry < &impl> ::gate()                                                         \
   }
 
 const std::vector<Command>& commands() {
@@ -129,6 +138,8 @@ const std::vector<Command>& commands() {
       MOCK_COMMAND(xrMockRuntimeSetScriptSDFG, mockSetScript, test),
       MOCK_COMMAND(xrMockRuntimeGetStatsSDFG, mockGetStats, test),
       MOCK_COMMAND(xrMockRuntimeGetCaptureSDFG, mockGetCapture, test),
+      MOCK_COMMAND(xrMockRuntimeGateCallsSDFG, mockGateCalls, test),
+      MOCK_COMMAND(xrMockRuntimeGateStatsSDFG, mockGateStats, test),
   };
   return table;
 }
@@ -174,6 +185,49 @@ XrResult getInstanceProcAddr(XrInstance instance, const char* name, PFN_xrVoidFu
   *function = found->function;
   return XR_SUCCESS;
 }
+
+}  // namespace
+
+CallGate* findGate(const char* command) {
+  if (command == nullptr) return nullptr;
+  for (const Command& c : commands()) {
+    if (std::strcmp(c.name, command) == 0) return c.gate;
+  }
+  return nullptr;
+}
+
+void CallGate::pass() {
+  if (!active_.load(std::memory_order_acquire)) return;
+  uint32_t delay = 0;
+  {
+    std::unique_lock lock(mutex_);
+    delay = delayMicroseconds_;
+    ++waiting_;
+    opened_.wait(lock, [&] { return !held_; });
+  }
+  if (delay > 0) std::this_thread::sleep_for(std::chrono::microseconds(delay));
+  std::lock_guard lock(mutex_);
+  --waiting_;
+  ++passed_;
+}
+
+void CallGate::set(bool hold, uint32_t delayMicroseconds) {
+  {
+    std::lock_guard lock(mutex_);
+    held_ = hold;
+    delayMicroseconds_ = delayMicroseconds;
+    active_.store(true, std::memory_order_release);
+  }
+  opened_.notify_all();
+}
+
+void CallGate::stats(uint32_t& waiting, uint64_t& passed) const {
+  std::lock_guard lock(mutex_);
+  waiting = waiting_;
+  passed = passed_;
+}
+
+namespace {
 
 // Loader structs, declared here because Debian's libopenxr-dev 1.0.20 ships no
 // loader_interfaces.h. Layouts from OpenXR-SDK-Source release-1.0.20 src/common.

@@ -137,6 +137,10 @@ XrResult locateHandJoints(XrHandTrackerEXT tracker, const XrHandJointsLocateInfo
 // test_functions.cpp and instance.cpp (mock_runtime_test.h)
 XrResult mockSetScript(XrInstance instance, const char* scriptText);
 XrResult mockGetStats(XrSession session, XrMockRuntimeStatsSDFG* stats);
+XrResult mockGateCalls(XrInstance instance, const char* command, XrBool32 hold,
+                       uint32_t delayMicroseconds);
+XrResult mockGateStats(XrInstance instance, const char* command, uint32_t* waiting,
+                       uint64_t* passed);
 XrResult mockGetCapture(XrSession session, uint32_t viewIndex, uint32_t capacityBytes,
                         uint32_t* width, uint32_t* height, uint8_t* rgba);
 

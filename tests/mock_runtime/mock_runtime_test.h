@@ -57,6 +57,8 @@ typedef struct XrMockRuntimeStatsSDFG {
   uint64_t syncCount;                             // xrSyncActions calls that succeeded
   XrHandJointsMotionRangeEXT lastMotionRange[2];  // last requested per hand, 0 if none
   uint64_t handTrackersRefused;  // xrCreateHandTrackerEXT calls refused: no hand tracking
+  uint32_t liveSpaces;           // spaces of the session not destroyed (the app's and layers')
+  uint32_t liveHandTrackers;     // hand trackers of the session not destroyed
 } XrMockRuntimeStatsSDFG;
 
 // Replaces the instance's timeline (and its directives) with `scriptText`, a NUL-terminated
@@ -79,6 +81,22 @@ typedef XrResult(XRAPI_PTR* PFN_xrMockRuntimeGetCaptureSDFG)(XrSession session, 
                                                              uint32_t capacityBytes,
                                                              uint32_t* width, uint32_t* height,
                                                              uint8_t* rgba);
+
+// Gates one command of the runtime (`command`, e.g. "xrGetActionStateFloat"), for tests of
+// callers with several threads. A gated call waits before it takes the runtime's lock, so the
+// other commands go on meanwhile: with `hold` XR_TRUE every call of the command waits until a
+// later call with `hold` XR_FALSE opens the gate; `delayMicroseconds` makes every call sleep that
+// long first (0: none). Process-wide, until changed. Errors: XR_ERROR_VALIDATION_FAILURE (null or
+// unknown command), XR_ERROR_HANDLE_INVALID (instance).
+typedef XrResult(XRAPI_PTR* PFN_xrMockRuntimeGateCallsSDFG)(XrInstance instance,
+                                                            const char* command, XrBool32 hold,
+                                                            uint32_t delayMicroseconds);
+
+// How many calls of `command` wait at its gate right now, and how many passed it since the
+// process started. Same errors as above.
+typedef XrResult(XRAPI_PTR* PFN_xrMockRuntimeGateStatsSDFG)(XrInstance instance,
+                                                            const char* command, uint32_t* waiting,
+                                                            uint64_t* passed);
 
 #ifdef __cplusplus
 }

@@ -3,7 +3,7 @@
 // mock_runtime_test.h through the loader).
 //
 // Threading: every entry point runs under one global mutex (see Entry in dispatch.cpp), so the
-// objects below need no locks of their own.
+// objects below need no locks of their own. A call gate (tests) waits before that mutex.
 #pragma once
 
 // openxr_platform.h needs the Vulkan and timespec types declared first.
@@ -16,6 +16,8 @@
 #include <openxr/openxr_platform.h>
 
 #include <array>
+#include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -258,6 +260,29 @@ struct Session final : Object {
   uint64_t frame() const { return stats.framesEnded; }
   bool focused() const { return state == XR_SESSION_STATE_FOCUSED; }
 };
+
+// ---- call gates (xrMockRuntimeGateCallsSDFG) -------------------------------------------------
+
+// One command's gate: every call passes it before the global lock; it can hold calls or delay
+// them. Inactive (one atomic load per call) until a test first sets it.
+class CallGate {
+ public:
+  void pass();
+  void set(bool hold, uint32_t delayMicroseconds);
+  void stats(uint32_t& waiting, uint64_t& passed) const;
+
+ private:
+  std::atomic<bool> active_{false};
+  mutable std::mutex mutex_;
+  std::condition_variable opened_;
+  bool held_ = false;
+  uint32_t delayMicroseconds_ = 0;
+  uint32_t waiting_ = 0;
+  uint64_t passed_ = 0;
+};
+
+// The gate of a command by name (xrGetActionStateFloat...); null for an unknown name.
+CallGate* findGate(const char* command);
 
 // ---- shared helpers ------------------------------------------------------------------------
 

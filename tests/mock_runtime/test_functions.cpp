@@ -1,5 +1,5 @@
-// Test-only commands of mock_runtime_test.h that read session state (xrMockRuntimeSetScriptSDFG
-// lives with the instance, which owns the script).
+// Test-only commands of mock_runtime_test.h that read session state, and the call gates
+// (xrMockRuntimeSetScriptSDFG lives with the instance, which owns the script).
 #include <cstring>
 
 #include "entry_points.h"
@@ -12,6 +12,8 @@ XrResult mockGetStats(XrSession handle, XrMockRuntimeStatsSDFG* stats) {
   if (session == nullptr) return fail(cmd, XR_ERROR_HANDLE_INVALID, "session is not valid");
   MOCK_VERIFY_NOT_NULL(cmd, stats);
   *stats = session->stats;
+  stats->liveSpaces = uint32_t(session->spaces.size());
+  stats->liveHandTrackers = uint32_t(session->handTrackers.size());
   return XR_SUCCESS;
 }
 
@@ -35,6 +37,30 @@ XrResult mockGetCapture(XrSession handle, uint32_t viewIndex, uint32_t capacityB
                 image.rgba.size());
   MOCK_VERIFY_NOT_NULL(cmd, rgba);
   std::memcpy(rgba, image.rgba.data(), image.rgba.size());
+  return XR_SUCCESS;
+}
+
+XrResult mockGateCalls(XrInstance handle, const char* command, XrBool32 hold,
+                       uint32_t delayMicroseconds) {
+  constexpr const char* cmd = "xrMockRuntimeGateCallsSDFG";
+  if (lookup<Instance>(handle) == nullptr)
+    return fail(cmd, XR_ERROR_HANDLE_INVALID, "instance is not valid");
+  CallGate* gate = findGate(command);
+  if (gate == nullptr) return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "(command) is unknown");
+  gate->set(hold == XR_TRUE, delayMicroseconds);
+  return XR_SUCCESS;
+}
+
+XrResult mockGateStats(XrInstance handle, const char* command, uint32_t* waiting,
+                       uint64_t* passed) {
+  constexpr const char* cmd = "xrMockRuntimeGateStatsSDFG";
+  if (lookup<Instance>(handle) == nullptr)
+    return fail(cmd, XR_ERROR_HANDLE_INVALID, "instance is not valid");
+  MOCK_VERIFY_NOT_NULL(cmd, waiting);
+  MOCK_VERIFY_NOT_NULL(cmd, passed);
+  const CallGate* gate = findGate(command);
+  if (gate == nullptr) return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "(command) is unknown");
+  gate->stats(*waiting, *passed);
   return XR_SUCCESS;
 }
 

@@ -1,9 +1,11 @@
 // GraspSession with a deferred SDF backend (the layer's Vulkan path, here a CPU stand-in that
 // counts its calls): builds are requested in update(), run only at submitDeferred(), collected
-// by a later update(); a device failure redoes the build on the CPU in the same update.
+// by a later update() and solved on the session's worker; a device failure has the worker redo
+// the build on the CPU at once. Every wait for the worker is for an outcome, with a time bound.
 #include <catch2/catch.hpp>
 
 #include <chrono>
+#include <thread>
 
 #include "grasp/grasp_session.h"
 #include "io/shapes.h"
@@ -103,6 +105,25 @@ HandFrame squeezing(float squeeze) {
   return f;
 }
 
+// Updates the squeezing hand until `done` holds, at most 20 s; true when it held.
+template <class F>
+bool updateUntil(GraspSession& session, const TargetFrame& target, F done) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (std::chrono::steady_clock::now() < deadline) {
+    REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    if (done()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return false;
+}
+
+// Adds a 4 cm sphere as target 7 and waits for its set-up on the worker.
+void addSphere(GraspSession& session) {
+  REQUIRE(session.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
+  REQUIRE(session.waitWorkerIdle(std::chrono::seconds(20)));
+  REQUIRE(session.targetSetup(7) == TargetSetup::ready);
+}
+
 }  // namespace
 
 TEST_CASE("GraspSession with a deferred backend solves only after the owner submits",
@@ -110,7 +131,7 @@ TEST_CASE("GraspSession with a deferred backend solves only after the owner subm
   auto owned = std::make_unique<FakeDeferred>();
   FakeDeferred& gpu = *owned;
   GraspSession session(makeCpuSdfBackend(1), std::move(owned));
-  REQUIRE(session.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
+  addSphere(session);
   const TargetFrame target{7, true, Pose{}};
 
   REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
@@ -126,10 +147,12 @@ TEST_CASE("GraspSession with a deferred backend solves only after the owner subm
     CHECK(gpu.requests == 1);  // one request at a time
     CHECK(gpu.submits == 0);
   }
-  SECTION("the result is collected and solved at the next update") {
+  SECTION("the result is collected at the next update and solved on the worker") {
     REQUIRE(session.submitDeferred(true) == Status::ok);
     CHECK(gpu.submits == 1);
     REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    CHECK(session.pendingBuilds() == 0);  // collected
+    REQUIRE(updateUntil(session, target, [&] { return session.grasp(Hand::right).shown(); }));
     const HandGrasp& g = session.grasp(Hand::right);
     CHECK(g.solves == 1);
     CHECK(g.builtOnGpu);
@@ -142,10 +165,12 @@ TEST_CASE("GraspSession with a deferred backend solves only after the owner subm
     REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
     CHECK(gpu.requests == 1);
   }
-  SECTION("a device failure at the poll redoes the build on the CPU in the same update") {
+  SECTION("a device failure at the poll has the worker redo the build on the CPU at once") {
     REQUIRE(session.submitDeferred(true) == Status::ok);
     gpu.failAtPoll = true;
     REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    CHECK(session.buildStats().gpuFailed);
+    REQUIRE(updateUntil(session, target, [&] { return session.grasp(Hand::right).shown(); }));
     const HandGrasp& g = session.grasp(Hand::right);
     CHECK(g.solves == 1);
     CHECK_FALSE(g.builtOnGpu);
@@ -154,9 +179,10 @@ TEST_CASE("GraspSession with a deferred backend solves only after the owner subm
     CHECK_FALSE(session.deferredUsable());
     // Later builds go to the CPU at once.
     session.release(Hand::right);
-    REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    REQUIRE(updateUntil(session, target, [&] { return session.grasp(Hand::right).shown(); }));
     CHECK(session.grasp(Hand::right).solves == 1);
     CHECK(session.buildStats().cpuBuilds == 2);
+    CHECK(gpu.requests == 1);
   }
   SECTION("releasing the squeeze cancels the build in flight") {
     REQUIRE(session.submitDeferred(true) == Status::ok);
@@ -209,14 +235,15 @@ TEST_CASE("While the deferred backend prepares, array targets build on the CPU a
   gpu.preparing = true;
   gpu.deviceMeshId = 9;
   GraspSession session(makeCpuSdfBackend(1), std::move(owned));
-  REQUIRE(session.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
+  addSphere(session);
   const TargetFrame target{7, true, Pose{}};
   CHECK_FALSE(session.deferredReady());
   CHECK(session.deferredUsable());
 
-  SECTION("an array target is grasped in the same update, on the CPU") {
+  SECTION("an array target is built on the CPU at once, not kept waiting for the device") {
     REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
     CHECK(session.grasp(Hand::right).holding);
+    REQUIRE(updateUntil(session, target, [&] { return session.grasp(Hand::right).shown(); }));
     CHECK(session.grasp(Hand::right).solves == 1);
     CHECK_FALSE(session.grasp(Hand::right).builtOnGpu);
     CHECK(session.buildStats().cpuBuilds == 1);
@@ -246,7 +273,7 @@ TEST_CASE("While the deferred backend prepares, array targets build on the CPU a
   }
   SECTION("a failed preparation counts as a GPU failure; the CPU builds from then on") {
     gpu.failPreparation = true;
-    REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    REQUIRE(updateUntil(session, target, [&] { return session.grasp(Hand::right).shown(); }));
     CHECK(session.grasp(Hand::right).solves == 1);
     CHECK(session.buildStats().gpuFailed);
     CHECK_FALSE(session.deferredUsable());

@@ -1,7 +1,7 @@
-// GraspSession with its worker (GraspThreading::worker, the layer's mode): the caller's update()
-// hands poses over and takes the newest finished result; set-ups, refits, builds and solves run
-// on the worker. No test counts updates until a result exists: each waits for the outcome with a
-// generous time bound (waitWorkerIdle, or a deadline).
+// GraspSession and its worker: the caller's update() hands poses over and takes the newest
+// finished result; set-ups, refits, builds and solves run on the worker. No test counts updates
+// until a result exists: each waits for the outcome with a generous time bound (waitWorkerIdle, or
+// a deadline).
 #include <catch2/catch.hpp>
 
 #include <atomic>
@@ -13,7 +13,9 @@
 
 #include "grasp/grasp_session.h"
 #include "grasp/grasp_worker.h"
+#include "grasp/solver.h"
 #include "io/shapes.h"
+#include "mesh/mesh_distance.h"
 #include "sdf/sdf_backend.h"
 
 namespace {
@@ -55,19 +57,28 @@ int contacts(const HandGrasp& g) {
 }
 
 // A CPU backend that blocks its builds until released, to hold a job on the worker. It honours
-// the build's WorkLimit as the CPU builder does, polling it while it waits.
+// the build's WorkLimit as the CPU builder does, polling it while it waits, and records whether
+// it was the limit's stop flag (not its deadline) that ended a wait.
 class GatedBackend final : public SdfBackend {
  public:
   explicit GatedBackend(std::shared_ptr<std::atomic<bool>> open,
-                        std::shared_ptr<std::atomic<int>> calls = nullptr)
-      : open_(std::move(open)), calls_(std::move(calls)), cpu_(makeCpuSdfBackend(1)) {}
+                        std::shared_ptr<std::atomic<int>> calls = nullptr,
+                        std::shared_ptr<std::atomic<bool>> stoppedByFlag = nullptr)
+      : open_(std::move(open)),
+        calls_(std::move(calls)),
+        stoppedByFlag_(std::move(stoppedByFlag)),
+        cpu_(makeCpuSdfBackend(1)) {}
   std::string_view name() const override { return "gated"; }
   using SdfBackend::build;
   Status build(const MeshDistance& target, const Pose& pose, const GridBox& box, SdfGrid& out,
                const WorkLimit& limit) override {
     if (calls_ != nullptr) ++*calls_;
     while (!open_->load()) {
-      if (limit.reached()) return Status::timed_out;
+      if (limit.reached()) {
+        if (stoppedByFlag_ != nullptr && limit.stop != nullptr && limit.stop->load())
+          stoppedByFlag_->store(true);
+        return Status::timed_out;
+      }
       std::this_thread::sleep_for(1ms);
     }
     return cpu_->build(target, pose, box, out, limit);
@@ -76,15 +87,14 @@ class GatedBackend final : public SdfBackend {
  private:
   std::shared_ptr<std::atomic<bool>> open_;
   std::shared_ptr<std::atomic<int>> calls_;
+  std::shared_ptr<std::atomic<bool>> stoppedByFlag_;
   std::unique_ptr<SdfBackend> cpu_;
 };
 
 }  // namespace
 
-TEST_CASE("GraspSession with a worker sets targets up off the caller's thread",
-          "[grasp_worker][core]") {
-  GraspSession session(makeCpuSdfBackend(1), nullptr, GraspThreading::worker);
-  REQUIRE(session.usesWorker());
+TEST_CASE("GraspSession sets targets up off the caller's thread", "[grasp_worker][core]") {
+  GraspSession session(makeCpuSdfBackend(1));
   REQUIRE(session.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
   // Known at once, graspable once the worker has built its exact distance.
   CHECK(session.hasTarget(7));
@@ -97,25 +107,39 @@ TEST_CASE("GraspSession with a worker sets targets up off the caller's thread",
   CHECK(session.addTarget(7, makeSphere(0.04f, 3)) == Status::invalid_argument);
 }
 
-TEST_CASE("GraspSession with a worker grasps as the caller-thread session does",
+TEST_CASE("The worker's grasp is the one a build and solve made directly give",
           "[grasp_worker][core]") {
   const TargetFrame target{7, true, Pose{}};
-  GraspSession inline_(makeCpuSdfBackend(1));
-  REQUIRE(inline_.configure(oursSettings()) == Status::ok);
-  REQUIRE(inline_.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
-  REQUIRE(inline_.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
-  const HandGrasp& expected = inline_.grasp(Hand::right);
-  REQUIRE(expected.solves == 1);
+  const TriangleMesh sphere = makeSphere(0.04f, 3);
+  const GraspSettings settings = oursSettings();
+  // Directly: the exact distance, the grab-box field, the solver with its exact check.
+  const Pose objectFromHand = squeezing(1.0f).worldFromWrist;  // the target sits at the origin
+  auto distance = MeshDistance::create(sphere);
+  REQUIRE(distance.ok());
+  SdfGrid grid;
+  REQUIRE(makeCpuSdfBackend(1)->build(**distance, objectFromHand, settings.box, grid) ==
+          Status::ok);
+  auto solver = createSolver("ours");
+  REQUIRE(solver.ok());
+  REQUIRE((*solver)->prepare(HandModel::defaultAdult(Hand::right), settings.box,
+                             settings.solverOptions) == Status::ok);
+  GraspScene scene;
+  scene.field = &grid;
+  scene.objectFromHand = objectFromHand;
+  MeshExactSource exact(**distance, objectFromHand);
+  scene.exact = &exact;
+  GraspResult expected;
+  REQUIRE((*solver)->solve(scene, expected) == Status::ok);
 
-  GraspSession session(makeCpuSdfBackend(1), nullptr, GraspThreading::worker);
-  REQUIRE(session.configure(oursSettings()) == Status::ok);
-  REQUIRE(session.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
+  GraspSession session(makeCpuSdfBackend(1));
+  REQUIRE(session.configure(settings) == Status::ok);
+  REQUIRE(session.addTarget(7, sphere) == Status::ok);
   REQUIRE(session.waitWorkerIdle(20s));
   REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
   // Holding from the squeeze; the solve arrives later.
   CHECK(session.grasp(Hand::right).holding);
   REQUIRE(updateUntil(session, squeezing(1.0f), target,
-                      [&] { return session.grasp(Hand::right).solves > 0; }));
+                      [&] { return session.grasp(Hand::right).shown(); }));
   const HandGrasp& g = session.grasp(Hand::right);
   CHECK(g.solves == 1);
   CHECK(contacts(g) >= 3);
@@ -123,7 +147,8 @@ TEST_CASE("GraspSession with a worker grasps as the caller-thread session does",
   // Same solver, same field, same exact check: the same curls.
   for (int f = 0; f < kFingerCount; ++f) {
     CAPTURE(f);
-    CHECK(g.result.fingers[f].curl == Approx(expected.result.fingers[f].curl).margin(1e-6));
+    CHECK(g.result.fingers[f].curl == Approx(expected.fingers[f].curl).margin(1e-6));
+    CHECK(g.result.fingers[f].contact == expected.fingers[f].contact);
   }
   // Nothing moved: no new job.
   REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
@@ -133,30 +158,41 @@ TEST_CASE("GraspSession with a worker grasps as the caller-thread session does",
 }
 
 TEST_CASE("A target still being set up is not grabbed", "[grasp_worker][core]") {
-  auto open = std::make_shared<std::atomic<bool>>(false);
-  GraspSession session(std::make_unique<GatedBackend>(open), nullptr, GraspThreading::worker);
+  auto open = std::make_shared<std::atomic<bool>>(true);
+  GraspSession session(std::make_unique<GatedBackend>(open));
   REQUIRE(session.configure(oursSettings()) == Status::ok);
+  // The worker is kept busy first: the left hand grabs target 5, whose build waits at the gate.
+  // A set-up queued behind it cannot start, so target 7 is surely still pending below.
+  REQUIRE(session.addTarget(5, makeSphere(0.04f, 2)) == Status::ok);
+  REQUIRE(session.waitWorkerIdle(20s));
+  open->store(false);
+  HandFrame left = squeezing(1.0f);
+  const TargetFrame five{5, true, Pose{}};
+  REQUIRE(session.update(Hand::left, left, {&five, 1}) == Status::ok);
+  REQUIRE(session.grasp(Hand::left).holding);
+  REQUIRE(session.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
   const TargetFrame target{7, true, Pose{}};
-  // A large sphere keeps the worker busy on its set-up for a while; the check below does not
-  // depend on it (a ready target is grabbed, a pending one is not, both are valid outcomes).
-  REQUIRE(session.addTarget(7, makeSphere(0.04f, 6)) == Status::ok);
+  REQUIRE(session.targetSetup(7) == TargetSetup::pending);
   REQUIRE(session.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
-  CHECK(session.grasp(Hand::right).holding == (session.targetSetup(7) == TargetSetup::ready));
+  CHECK_FALSE(session.grasp(Hand::right).holding);
+  CHECK(session.targetSetup(7) == TargetSetup::pending);
+  // Once the worker is free the set-up runs, and the same squeeze grabs.
   open->store(true);
   REQUIRE(updateUntil(session, squeezing(1.0f), target,
-                      [&] { return session.grasp(Hand::right).solves > 0; }));
+                      [&] { return session.grasp(Hand::right).shown(); }));
+  CHECK(session.targetSetup(7) == TargetSetup::ready);
 }
 
 TEST_CASE("A hand keeps its last solve while the next one runs, re-posed onto the target",
           "[grasp_worker][core]") {
   auto open = std::make_shared<std::atomic<bool>>(true);
-  GraspSession session(std::make_unique<GatedBackend>(open), nullptr, GraspThreading::worker);
+  GraspSession session(std::make_unique<GatedBackend>(open));
   REQUIRE(session.configure(oursSettings()) == Status::ok);
   REQUIRE(session.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
   REQUIRE(session.waitWorkerIdle(20s));
   TargetFrame target{7, true, Pose{}};
   REQUIRE(updateUntil(session, squeezing(1.0f), target,
-                      [&] { return session.grasp(Hand::right).solves > 0; }));
+                      [&] { return session.grasp(Hand::right).shown(); }));
   const GraspResult first = session.grasp(Hand::right).result;
   CHECK_FALSE(session.reposeCorrection(Hand::right).has_value());
 
@@ -189,14 +225,14 @@ TEST_CASE("A hand keeps its last solve while the next one runs, re-posed onto th
 }
 
 TEST_CASE("New vertices are refit on the worker and re-solved", "[grasp_worker][core]") {
-  GraspSession session(makeCpuSdfBackend(1), nullptr, GraspThreading::worker);
+  GraspSession session(makeCpuSdfBackend(1));
   REQUIRE(session.configure(oursSettings()) == Status::ok);
   TriangleMesh sphere = makeSphere(0.04f, 3);
   REQUIRE(session.addTarget(7, sphere) == Status::ok);
   REQUIRE(session.waitWorkerIdle(20s));
   const TargetFrame target{7, true, Pose{}};
   REQUIRE(updateUntil(session, squeezing(1.0f), target,
-                      [&] { return session.grasp(Hand::right).solves > 0; }));
+                      [&] { return session.grasp(Hand::right).shown(); }));
   const float before = session.grasp(Hand::right).result.fingers[2].curl;
   // A smaller sphere: the fingers close further.
   std::vector<glm::vec3> smaller = sphere.positions;
@@ -213,8 +249,7 @@ TEST_CASE("Releasing, removing the target or destroying the session while a job 
   auto open = std::make_shared<std::atomic<bool>>(true);
   const TargetFrame target{7, true, Pose{}};
   auto makeHeld = [&] {
-    auto session = std::make_unique<GraspSession>(std::make_unique<GatedBackend>(open), nullptr,
-                                                  GraspThreading::worker);
+    auto session = std::make_unique<GraspSession>(std::make_unique<GatedBackend>(open));
     REQUIRE(session->configure(oursSettings()) == Status::ok);
     REQUIRE(session->addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
     REQUIRE(session->waitWorkerIdle(20s));
@@ -243,15 +278,31 @@ TEST_CASE("Releasing, removing the target or destroying the session while a job 
     CHECK_FALSE(session->grasp(Hand::right).holding);
   }
   SECTION("destroying the session stops the build in flight and joins the worker") {
-    auto session = makeHeld();
-    // The gate never opens: without the stop flag this would wait for the build's time bound.
+    auto stopped = std::make_shared<std::atomic<bool>>(false);
+    auto calls = std::make_shared<std::atomic<int>>(0);
+    auto session =
+        std::make_unique<GraspSession>(std::make_unique<GatedBackend>(open, calls, stopped));
+    GraspSettings settings = oursSettings();
+    settings.buildTimeLimit = std::chrono::minutes(10);  // the deadline cannot be what ends it
+    REQUIRE(session->configure(settings) == Status::ok);
+    REQUIRE(session->addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
+    REQUIRE(session->waitWorkerIdle(20s));
+    open->store(false);  // the grab's build waits on the worker until something stops it
+    REQUIRE(session->update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+    REQUIRE(session->grasp(Hand::right).holding);
+    // Destroyed once the build is surely running (the gate has been reached).
+    const auto deadline = std::chrono::steady_clock::now() + 20s;
+    while (calls->load() == 0 && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(1ms);
+    REQUIRE(calls->load() == 1);
     session.reset();  // returns once the worker has ended; nothing runs after
-    SUCCEED("destroyed");
+    // The gate never opened and the deadline is ten minutes off: the destructor's stop flag is
+    // what ended the build.
+    CHECK(stopped->load());
   }
   SECTION("destroying the session with set-ups queued drops them") {
     open->store(true);
-    auto session = std::make_unique<GraspSession>(std::make_unique<GatedBackend>(open), nullptr,
-                                                  GraspThreading::worker);
+    auto session = std::make_unique<GraspSession>(std::make_unique<GatedBackend>(open));
     for (uint64_t id = 1; id <= 8; ++id)
       REQUIRE(session->addTarget(id, makeSphere(0.04f, 5)) == Status::ok);
     session.reset();
@@ -278,7 +329,7 @@ TEST_CASE("A failing job leaves the hand open and the worker working", "[grasp_w
     bool failed_ = false;
     std::unique_ptr<SdfBackend> cpu_ = makeCpuSdfBackend(1);
   };
-  GraspSession session(std::make_unique<FailingOnce>(), nullptr, GraspThreading::worker);
+  GraspSession session(std::make_unique<FailingOnce>());
   REQUIRE(session.configure(oursSettings()) == Status::ok);
   REQUIRE(session.addTarget(7, makeSphere(0.04f, 3)) == Status::ok);
   REQUIRE(session.waitWorkerIdle(20s));
@@ -290,7 +341,7 @@ TEST_CASE("A failing job leaves the hand open and the worker working", "[grasp_w
   // The next squeeze grabs again.
   session.release(Hand::right);
   REQUIRE(updateUntil(session, squeezing(1.0f), target,
-                      [&] { return session.grasp(Hand::right).solves > 0; }));
+                      [&] { return session.grasp(Hand::right).shown(); }));
 }
 
 TEST_CASE("A mesh the worker cannot set up is reported once and never grabbed",
@@ -309,13 +360,13 @@ TEST_CASE("A mesh the worker cannot set up is reported once and never grabbed",
 TEST_CASE("A rigid motion of a held target re-solves on the field already built",
           "[grasp_worker][core]") {
   const TriangleMesh sphere = makeSphere(0.04f, 3);
-  GraspSession session(makeCpuSdfBackend(1), nullptr, GraspThreading::worker);
+  GraspSession session(makeCpuSdfBackend(1));
   REQUIRE(session.configure(oursSettings()) == Status::ok);
   REQUIRE(session.addTarget(7, sphere) == Status::ok);
   REQUIRE(session.waitWorkerIdle(20s));
   TargetFrame target{7, true, Pose{}};
   REQUIRE(updateUntil(session, squeezing(1.0f), target,
-                      [&] { return session.grasp(Hand::right).solves > 0; }));
+                      [&] { return session.grasp(Hand::right).shown(); }));
   REQUIRE(session.buildStats().cpuBuilds == 1);
 
   // The target starts moving in the hand: its next field is built in a grown box...
@@ -337,9 +388,12 @@ TEST_CASE("A rigid motion of a held target re-solves on the field already built"
   GraspSession fresh(makeCpuSdfBackend(1));
   REQUIRE(fresh.configure(oursSettings()) == Status::ok);
   REQUIRE(fresh.addTarget(7, sphere) == Status::ok);
-  REQUIRE(fresh.update(Hand::right, squeezing(1.0f), {&target, 1}) == Status::ok);
+  REQUIRE(fresh.waitWorkerIdle(20s));
+  REQUIRE(updateUntil(fresh, squeezing(1.0f), target,
+                      [&] { return fresh.grasp(Hand::right).shown(); }));
   const GraspResult& expected = fresh.grasp(Hand::right).result;
   REQUIRE(fresh.grasp(Hand::right).solves == 1);
+  REQUIRE(fresh.buildStats().reusedFields == 0);
   for (int f = 0; f < kFingerCount; ++f) {
     CAPTURE(f);
     CHECK(reused.fingers[f].contact == expected.fingers[f].contact);
@@ -370,8 +424,7 @@ TEST_CASE("A build over its time bound is given up once per squeeze", "[grasp_wo
   // The gate never opens: every build runs into its bound (50 ms here, 1 s by default).
   auto open = std::make_shared<std::atomic<bool>>(false);
   auto calls = std::make_shared<std::atomic<int>>(0);
-  GraspSession session(std::make_unique<GatedBackend>(open, calls), nullptr,
-                       GraspThreading::worker);
+  GraspSession session(std::make_unique<GatedBackend>(open, calls));
   GraspSettings settings = oursSettings();
   settings.buildTimeLimit = 50ms;
   REQUIRE(session.configure(settings) == Status::ok);
@@ -399,27 +452,27 @@ TEST_CASE("A build over its time bound is given up once per squeeze", "[grasp_wo
   REQUIRE(session.update(Hand::right, squeezing(0.0f), {&target, 1}) == Status::ok);
   open->store(true);
   REQUIRE(updateUntil(session, squeezing(1.0f), target,
-                      [&] { return session.grasp(Hand::right).solves > 0; }));
+                      [&] { return session.grasp(Hand::right).shown(); }));
 }
 
 TEST_CASE("Settings refuse a build time bound that is not positive", "[grasp_worker][core]") {
   GraspSettings settings = oursSettings();
   settings.buildTimeLimit = 0ms;
   CHECK(settings.validate().has_value());
-  GraspSession session(makeCpuSdfBackend(1), nullptr, GraspThreading::worker);
+  GraspSession session(makeCpuSdfBackend(1));
   CHECK(session.configure(settings) == Status::invalid_argument);
 }
 
 TEST_CASE("New vertices that collapse a triangle are refused on the worker, once per run",
           "[grasp_worker][core]") {
-  GraspSession session(makeCpuSdfBackend(1), nullptr, GraspThreading::worker);
+  GraspSession session(makeCpuSdfBackend(1));
   REQUIRE(session.configure(oursSettings()) == Status::ok);
   const TriangleMesh sphere = makeSphere(0.04f, 3);
   REQUIRE(session.addTarget(7, sphere) == Status::ok);
   REQUIRE(session.waitWorkerIdle(20s));
   const TargetFrame target{7, true, Pose{}};
   REQUIRE(updateUntil(session, squeezing(1.0f), target,
-                      [&] { return session.grasp(Hand::right).solves > 0; }));
+                      [&] { return session.grasp(Hand::right).shown(); }));
   const float curl = session.grasp(Hand::right).result.fingers[2].curl;
   // Triangle 0's corners all at one point; the sphere otherwise shrunk, which the hand would
   // close further on if the update were taken.

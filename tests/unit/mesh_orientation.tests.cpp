@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <atomic>
 #include <utility>
 #include <vector>
 
@@ -139,4 +140,21 @@ TEST_CASE("Generalized winding number: 1 inside, 0 outside, -1 inside out", "[me
   CHECK(windingNumberAt(sphere.positions, sphere.indices, {0.2, 0, 0}) == Approx(0.0).margin(1e-6));
   CHECK(windingNumberAt(inverted.positions, inverted.indices, {0, 0, 0}) ==
         Approx(-1.0).margin(1e-6));
+}
+
+TEST_CASE("A stopped orientation leaves the indices as given", "[mesh_orientation][work_limit]") {
+  std::atomic<bool> stop{true};
+  const WorkLimit stopped{WorkLimit::Clock::time_point::max(), &stop};
+  TriangleMesh inverted = clockwise(makeSphere(0.04f, 4));
+  const std::vector<uint32_t> given = inverted.indices;
+  const MeshOrientation o = orientOutward(inverted.positions, inverted.indices, stopped);
+  CHECK(o.stopped);
+  CHECK(o.flipped == 0);
+  CHECK(inverted.indices == given);
+  // Not stopped, the same mesh is turned outward.
+  stop = false;
+  const MeshOrientation done = orientOutward(inverted.positions, inverted.indices, stopped);
+  CHECK_FALSE(done.stopped);
+  CHECK(done.flipped == inverted.triangleCount());
+  CHECK(signedVolume6(inverted) > 0.0);
 }

@@ -1,6 +1,8 @@
 #include <catch2/catch.hpp>
 
+#include <iterator>
 #include <memory>
+#include <set>
 #include <string>
 
 #include "base/status.h"
@@ -28,6 +30,22 @@ TEST_CASE("Result holds either a value or an error", "[core][status]") {
 }
 
 TEST_CASE("Every status has a readable name", "[core][status]") {
-  CHECK(std::string(sdfg::toString(sdfg::Status::ok)) == "ok");
-  CHECK(std::string(sdfg::toString(sdfg::Status::device_lost)) == "device lost");
+  using sdfg::Status;
+  // Every enumerator, in declaration order (internal is the last): a new one must be added here,
+  // and to toString, or the size check below fails.
+  const Status all[] = {Status::ok,          Status::invalid_argument, Status::io_error,
+                        Status::unsupported, Status::out_of_memory,    Status::device_lost,
+                        Status::timed_out,   Status::internal};
+  static_assert(int(Status::internal) + 1 == int(std::size(all)), "a status is missing here");
+  std::set<std::string> names;
+  for (Status s : all) {
+    const std::string name = sdfg::toString(s);
+    CAPTURE(int(s), name);
+    CHECK_FALSE(name.empty());
+    CHECK(name != "unknown status");  // toString's answer for a value it does not list
+    names.insert(name);
+  }
+  CHECK(names.size() == std::size(all));  // no two alike
+  CHECK(std::string(sdfg::toString(Status::ok)) == "ok");
+  CHECK(std::string(sdfg::toString(Status::device_lost)) == "device lost");
 }

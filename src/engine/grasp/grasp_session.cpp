@@ -39,34 +39,27 @@ std::optional<Error> GraspSettings::validate() const {
 }
 
 GraspSession::GraspSession(std::unique_ptr<SdfBackend> backend,
-                           std::unique_ptr<DeferredSdfBackend> deferred, GraspThreading threading)
+                           std::unique_ptr<DeferredSdfBackend> deferred)
     : deferred_(std::move(deferred)) {
   hands_[0].model = HandModel::defaultAdult(Hand::left);
   hands_[1].model = HandModel::defaultAdult(Hand::right);
   (void)configure(settings_);
-  // With a worker, the CPU builder is the worker's alone.
-  if (threading == GraspThreading::worker)
-    worker_ = std::make_unique<GraspWorker>(std::move(backend));
-  else
-    backend_ = std::move(backend);
+  // The CPU builder is the worker's alone.
+  worker_ = std::make_unique<GraspWorker>(std::move(backend));
 }
 
 GraspSession::~GraspSession() = default;
 
 Status GraspSession::configure(const GraspSettings& settings) {
   if (settings.validate()) return Status::invalid_argument;
-  std::array<std::unique_ptr<GraspSolver>, 2> solvers;
-  for (auto& s : solvers) {
-    auto made = createSolver(settings.solver);
-    if (!made) return made.error().code;
-    if (!(*made)->needsField() || (*made)->needsCollider()) return Status::unsupported;
-    s = std::move(*made);
-  }
+  // The strategy must exist and read the SDF; the worker gets its own instances (prepareSolver).
+  auto made = createSolver(settings.solver);
+  if (!made) return made.error().code;
+  if (!(*made)->needsField() || (*made)->needsCollider()) return Status::unsupported;
   settings_ = settings;
   for (size_t h = 0; h < 2; ++h) {
     // A build in flight was made for the old box: drop it, a held hand asks again.
     cancelPending(hands_[h], h);
-    hands_[h].solver = std::move(solvers[h]);
     hands_[h].prepared = false;
   }
   return Status::ok;
@@ -76,25 +69,13 @@ Status GraspSession::addTarget(uint64_t id, TriangleMesh mesh) {
   if (targets_.count(id) != 0) return Status::invalid_argument;
   Target t;
   t.meshTarget = true;
-  if (worker_ != nullptr) {
-    // The set-up (seconds for a million triangles) is the worker's; the target is graspable
-    // once it is ready (refreshSetups).
-    if (deferredUsable() && deferredForMeshTargets_)
-      t.deviceCopy = std::make_unique<TriangleMesh>(mesh);
-    t.setup = TargetSetup::pending;
-    t.vertexCount = mesh.positions.size();
-    worker_->addTarget(id, std::move(mesh));
-    targets_.emplace(id, std::move(t));
-    return Status::ok;
-  }
-  setupOrientations_.emplace_back(id, orientOutward(mesh.positions, mesh.indices));
-  auto distance = MeshDistance::create(mesh);
-  if (!distance) {
-    setupOrientations_.pop_back();
-    return distance.error().code;
-  }
-  t.bounds = computeBounds(mesh.positions);
-  t.distance = std::move(*distance);
+  // The set-up (a second for a few hundred thousand triangles) is the worker's; the target is
+  // graspable once it is ready (refreshSetups).
+  if (deferredUsable() && deferredForMeshTargets_)
+    t.deviceCopy = std::make_unique<TriangleMesh>(mesh);
+  t.setup = TargetSetup::pending;
+  t.vertexCount = mesh.positions.size();
+  worker_->addTarget(id, std::move(mesh));
   targets_.emplace(id, std::move(t));
   return Status::ok;
 }
@@ -102,8 +83,7 @@ Status GraspSession::addTarget(uint64_t id, TriangleMesh mesh) {
 TargetSetup GraspSession::targetSetup(uint64_t id) const {
   auto it = targets_.find(id);
   if (it == targets_.end()) return TargetSetup::unknown;
-  if (it->second.setup == TargetSetup::pending && worker_ != nullptr)
-    return worker_->targetInfo(id).setup;
+  if (it->second.setup == TargetSetup::pending) return worker_->targetInfo(id).setup;
   return it->second.setup;
 }
 
@@ -113,8 +93,7 @@ std::vector<std::pair<uint64_t, std::string>> GraspSession::takeSetupFailures() 
 }
 
 std::vector<std::pair<uint64_t, std::string>> GraspSession::takeRefusedUpdates() {
-  return worker_ != nullptr ? worker_->takeRefusedUpdates()
-                            : std::vector<std::pair<uint64_t, std::string>>{};
+  return worker_->takeRefusedUpdates();
 }
 
 std::vector<std::pair<uint64_t, MeshOrientation>> GraspSession::takeSetupOrientations() {
@@ -123,11 +102,10 @@ std::vector<std::pair<uint64_t, MeshOrientation>> GraspSession::takeSetupOrienta
 }
 
 bool GraspSession::waitWorkerIdle(std::chrono::milliseconds timeout) const {
-  return worker_ == nullptr || worker_->waitIdle(timeout);
+  return worker_->waitIdle(timeout);
 }
 
 void GraspSession::refreshSetups() {
-  if (worker_ == nullptr) return;
   for (auto& [id, t] : targets_) {
     if (t.setup != TargetSetup::pending) continue;
     GraspWorker::TargetInfo info = worker_->targetInfo(id);
@@ -148,7 +126,7 @@ void GraspSession::refreshSetups() {
 
 std::optional<Pose> GraspSession::reposeCorrection(Hand side) const {
   const HandState& hand = hands_[size_t(side)];
-  if (!hand.grasp.holding || hand.grasp.solves == 0 || !hand.objectFromHandNow) return std::nullopt;
+  if (!hand.grasp.shown() || !hand.objectFromHandNow) return std::nullopt;
   const Pose& now = *hand.objectFromHandNow;
   const Pose& solved = hand.grasp.objectFromHand;
   if (glm::length(now.position - solved.position) <= settings_.moveTolerance &&
@@ -204,7 +182,7 @@ void GraspSession::dropDeferred() {
 void GraspSession::cancelPending(HandState& hand, size_t slot) {
   if (hand.pending && deferred_ != nullptr) deferred_->cancel(slot);
   hand.pending = false;
-  if (hand.jobPending && worker_ != nullptr) worker_->cancel(slot);
+  if (hand.jobPending) worker_->cancel(slot);
   hand.jobPending = false;
 }
 
@@ -212,27 +190,20 @@ Status GraspSession::updateTargetVertices(uint64_t id, std::span<const glm::vec3
   auto it = targets_.find(id);
   if (it == targets_.end() || !it->second.meshTarget) return Status::invalid_argument;
   Target& t = it->second;
-  if (worker_ != nullptr) {
-    // The refit is the worker's, before its next build of this target (latest positions win).
-    if (positions.size() != t.vertexCount) return Status::invalid_argument;
-    if (t.deviceCopy != nullptr) {
-      std::copy(positions.begin(), positions.end(), t.deviceCopy->positions.begin());
-    }
-    t.bounds = computeBounds(positions);
-    ++t.version;
-    worker_->updateVertices(id, std::vector<glm::vec3>(positions.begin(), positions.end()),
-                            t.version);
-    return Status::ok;
+  // The refit is the worker's, before its next build of this target (latest positions win).
+  if (positions.size() != t.vertexCount) return Status::invalid_argument;
+  if (t.deviceCopy != nullptr) {
+    std::copy(positions.begin(), positions.end(), t.deviceCopy->positions.begin());
   }
-  if (Status s = t.distance->updatePositions(positions); s != Status::ok) return s;
   t.bounds = computeBounds(positions);
   ++t.version;
+  worker_->updateVertices(id, std::vector<glm::vec3>(positions.begin(), positions.end()),
+                          t.version);
   return Status::ok;
 }
 
 Status GraspSession::updateTargetVertices(uint64_t id, std::vector<glm::vec3>&& positions,
                                           const Aabb& bounds) {
-  if (worker_ == nullptr) return updateTargetVertices(id, std::span<const glm::vec3>(positions));
   auto it = targets_.find(id);
   if (it == targets_.end() || !it->second.meshTarget) return Status::invalid_argument;
   Target& t = it->second;
@@ -246,7 +217,7 @@ Status GraspSession::updateTargetVertices(uint64_t id, std::vector<glm::vec3>&& 
 }
 
 std::vector<glm::vec3> GraspSession::vertexBuffer(uint64_t id) {
-  return worker_ != nullptr ? worker_->spareBuffer(id) : std::vector<glm::vec3>{};
+  return worker_->spareBuffer(id);
 }
 
 bool GraspSession::removeTarget(uint64_t id) {
@@ -256,7 +227,7 @@ bool GraspSession::removeTarget(uint64_t id) {
       hands_[h].grasp = HandGrasp{};
     }
   }
-  if (worker_ != nullptr) worker_->removeTarget(id);
+  worker_->removeTarget(id);
   return targets_.erase(id) != 0;
 }
 
@@ -311,22 +282,15 @@ std::optional<uint64_t> GraspSession::pickTarget(Hand side, const Pose& worldFro
 
 Status GraspSession::prepareSolver(HandState& hand) {
   if (hand.prepared) return Status::ok;
-  if (worker_ != nullptr) {
-    // The worker may be solving with the current one: a new one, prepared by the worker.
-    auto made = createSolver(settings_.solver);
-    if (!made) return made.error().code;
-    auto setup = std::make_shared<GraspWorker::SolverSetup>();
-    setup->solver = std::move(*made);
-    setup->model = hand.model;
-    setup->box = settings_.box;
-    setup->options = settings_.solverOptions;
-    hand.workerSolver = std::move(setup);
-    hand.prepared = true;
-    return Status::ok;
-  }
-  if (Status s = hand.solver->prepare(hand.model, settings_.box, settings_.solverOptions);
-      s != Status::ok)
-    return s;
+  // The worker may be solving with the current one: a new one, prepared by the worker.
+  auto made = createSolver(settings_.solver);
+  if (!made) return made.error().code;
+  auto setup = std::make_shared<GraspWorker::SolverSetup>();
+  setup->solver = std::move(*made);
+  setup->model = hand.model;
+  setup->box = settings_.box;
+  setup->options = settings_.solverOptions;
+  hand.workerSolver = std::move(setup);
   hand.prepared = true;
   return Status::ok;
 }
@@ -351,7 +315,7 @@ void GraspSession::post(HandState& hand, size_t slot, uint64_t id, const Pose& o
 }
 
 Status GraspSession::collectJob(HandState& hand, size_t slot) {
-  if (!hand.jobPending || worker_ == nullptr) return Status::ok;
+  if (!hand.jobPending) return Status::ok;
   std::optional<GraspWorker::Done> done = worker_->take(slot);
   if (!done) return Status::ok;
   if (done->ticket != hand.ticket) return Status::ok;  // of a cancelled job
@@ -384,9 +348,7 @@ Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Targ
     // keep the hand waiting. A preparation that failed leaves the CPU only.
     if (!target.meshTarget && deferredUsable()) return Status::ok;
   } else if (onDevice) {
-    const TriangleMesh* mesh = target.distance     ? &target.distance->mesh()
-                               : target.deviceCopy ? target.deviceCopy.get()
-                                                   : nullptr;
+    const TriangleMesh* mesh = target.deviceCopy.get();
     const Status s =
         deferred_->request(slot, id, target.version, mesh, objectFromHand, settings_.box);
     if (s == Status::ok) {
@@ -403,16 +365,8 @@ Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Targ
     stats_.gpuFailed = true;  // the device failed: this and every later build on the CPU
   }
   if (!target.meshTarget) return Status::device_lost;
-  if (worker_ != nullptr) {
-    post(hand, slot, id, objectFromHand, std::nullopt, false, hand.frameTime);
-    return Status::ok;
-  }
-  if (Status s = backend_->build(*target.distance, objectFromHand, settings_.box, hand.grid);
-      s != Status::ok)
-    return s;
-  ++stats_.cpuBuilds;
-  return solveWithGrid(hand, objectFromHand, target.version, false, target.distance.get(),
-                       hand.frameTime);
+  post(hand, slot, id, objectFromHand, std::nullopt, false, hand.frameTime);
+  return Status::ok;
 }
 
 void GraspSession::noteTrackedParts(HandState& hand, const HandFrame& frame) {
@@ -423,30 +377,6 @@ void GraspSession::noteTrackedParts(HandState& hand, const HandFrame& frame) {
   for (int j = 0; j < kJointCount; ++j)
     local[size_t(j)] = wristFromWorld * (*frame.trackedJoints)[size_t(j)];
   hand.trackedPartCount = jointParts(local, *frame.trackedRadii, hand.trackedParts);
-}
-
-Status GraspSession::solveWithGrid(HandState& hand, const Pose& objectFromHand, uint64_t version,
-                                   bool gpu, const MeshDistance* exactMesh, int64_t time) {
-  GraspScene scene;
-  scene.field = &hand.grid;
-  scene.extraParts =
-      std::span<const HandPart>(hand.trackedParts.data(), size_t(hand.trackedPartCount));
-  scene.objectFromHand = objectFromHand;
-  std::optional<MeshExactSource> exact;
-  if (settings_.exactCheck && exactMesh != nullptr) {
-    exact.emplace(*exactMesh, objectFromHand);
-    scene.exact = &*exact;
-  }
-  GraspResult result;
-  if (Status s = hand.solver->solve(scene, result); s != Status::ok) return s;
-  hand.grasp.result = result;
-  hand.grasp.contacts = computeContacts(hand.model, result, objectFromHand, exactMesh, &hand.grid);
-  hand.grasp.time = time;
-  hand.grasp.objectFromHand = objectFromHand;
-  hand.grasp.builtOnGpu = gpu;
-  hand.solvedVersion = version;
-  ++hand.grasp.solves;
-  return Status::ok;
 }
 
 Status GraspSession::collect(HandState& hand, size_t slot) {
@@ -461,35 +391,19 @@ Status GraspSession::collect(HandState& hand, size_t slot) {
   auto it = hand.grasp.holding ? targets_.find(hand.grasp.target) : targets_.end();
   if (it == targets_.end()) return Status::ok;
   if (p == BuildPoll::ready) {
-    if (worker_ != nullptr) {
-      // The solve, with its exact check, is the worker's too; the build counts once its grasp
-      // is taken (collectJob), so the count says the grasp shown has it.
-      post(hand, slot, it->first, hand.pendingPose, hand.grid, true, hand.pendingTime);
-      return Status::ok;
-    }
-    ++stats_.gpuBuilds;
-    // A result for older vertices is still shown; the next update asks again.
-    return solveWithGrid(hand, hand.pendingPose, hand.pendingVersion, true,
-                         it->second.distance.get(), hand.pendingTime);
+    // The solve, with its exact check, is the worker's too; the build counts once its grasp is
+    // taken (collectJob), so the count says the grasp shown has it.
+    post(hand, slot, it->first, hand.pendingPose, hand.grid, true, hand.pendingTime);
+    return Status::ok;
   }
-  // The device failed (or lost the request): redo the build on the CPU now.
+  // The device failed (or lost the request): the worker redoes the build on the CPU now.
   if (p == BuildPoll::failed) stats_.gpuFailed = true;
   if (!it->second.meshTarget) {
     hand.grasp = HandGrasp{};
     return Status::device_lost;
   }
-  if (worker_ != nullptr) {
-    post(hand, slot, it->first, hand.pendingPose, std::nullopt, false, hand.pendingTime);
-    return Status::ok;
-  }
-  if (Status s = backend_->build(*it->second.distance, hand.pendingPose, settings_.box, hand.grid);
-      s != Status::ok) {
-    hand.grasp = HandGrasp{};
-    return s;
-  }
-  ++stats_.cpuBuilds;
-  return solveWithGrid(hand, hand.pendingPose, hand.pendingVersion, false,
-                       it->second.distance.get(), hand.pendingTime);
+  post(hand, slot, it->first, hand.pendingPose, std::nullopt, false, hand.pendingTime);
+  return Status::ok;
 }
 
 Status GraspSession::update(Hand side, const HandFrame& frame,

@@ -7,23 +7,23 @@
 // the squeeze drops below threshold * releaseRatio or the target goes away. While held, the grasp
 // is solved again when the target moves relative to the hand or its vertices change.
 //
-// Threading (GraspThreading): with `caller`, CPU builds and solves run inside update() on the
-// caller's thread (unit tests, tools). With `worker` (the layer), a GraspWorker owned by the
-// session runs the target set-up (addTarget returns at once; the target is graspable once
-// targetSetup() says ready), the refit after new vertices, the CPU builds and every solve with its
-// exact check; update() only hands the frame's poses over and takes the newest finished result,
-// never waiting. Until a newer result arrives a hand keeps its last solve (reposeCorrection()
-// says how to keep it on a target that moved since).
+// Threading: a GraspWorker owned by the session runs the target set-up (addTarget returns at
+// once; the target is graspable once targetSetup() says ready), the refit after new vertices, the
+// CPU builds and every solve with its exact check; update() only hands the frame's poses over and
+// takes the newest finished result, never waiting. Until a newer result arrives a hand keeps its
+// last solve (reposeCorrection() says how to keep it on a target that moved since). Tests and
+// tools wait for outcomes (waitWorkerIdle, or a deadline), never for a number of updates.
 //
-// SDF builds: on the CPU backend during update(); or, with a DeferredSdfBackend (the app's Vulkan
+// SDF builds: on the CPU backend, on the worker; or, with a DeferredSdfBackend (the app's Vulkan
 // device), requested during update(), submitted by the owner through submitDeferred() where it
-// may use the queue, and collected by a later update() (one frame or more of latency; a hand
-// counts as holding from the request, its grasp has solves == 0 until the first result). While
-// the deferred backend is not ready yet (preparing its pipelines at session start) a target with
-// a CPU mesh is built on the CPU at once and a device target waits. After a failure of the
-// deferred backend every build goes to the CPU; targets that exist only on the device
+// may use the queue, collected by a later update() and solved on the worker (one frame or more of
+// latency; a hand counts as holding from the request, its grasp is not shown() until the first
+// result). While the deferred backend is not ready yet (preparing its pipelines at session start)
+// a target with a CPU mesh is built on the CPU at once and a device target waits. After a failure
+// of the deferred backend every build goes to the CPU; targets that exist only on the device
 // (addDeviceTarget) can no longer be grasped.
-// Not thread-safe: the owner serializes calls (the layer holds its session lock).
+// Not thread-safe: the owner serializes calls (the layer holds its session lock, which it never
+// holds across a call into the runtime or Vulkan: docs/threading.md).
 #pragma once
 
 #include <chrono>
@@ -94,6 +94,10 @@ struct TargetFrame {
 };
 
 struct HandGrasp {
+  // The grasp the hand shows: holding, with a first solve in. (Holding alone is the time between
+  // the squeeze and that solve, when the hand still shows the user's own pose.)
+  bool shown() const { return holding && solves > 0; }
+
   bool holding = false;
   uint64_t target = 0;
   GraspResult result{};     // contact points in hand space
@@ -114,19 +118,12 @@ struct SdfBuildStats {
   bool gpuFailed = false;     // the deferred backend failed; the CPU builds from then on
 };
 
-// Where the CPU builds and the solves run (see the top of this file).
-enum class GraspThreading {
-  caller,  // inside update(), on the caller's thread
-  worker,  // on a thread owned by the session; update() never waits
-};
-
 class GraspSession {
  public:
   // `backend`: the CPU builder (always needed: headless sessions and the fallback). `deferred`:
   // optional device backend used first while it works.
   explicit GraspSession(std::unique_ptr<SdfBackend> backend,
-                        std::unique_ptr<DeferredSdfBackend> deferred = nullptr,
-                        GraspThreading threading = GraspThreading::caller);
+                        std::unique_ptr<DeferredSdfBackend> deferred = nullptr);
   ~GraspSession();
   GraspSession(const GraspSession&) = delete;
   GraspSession& operator=(const GraspSession&) = delete;
@@ -136,25 +133,26 @@ class GraspSession {
   Status configure(const GraspSettings& settings);
   const GraspSettings& settings() const { return settings_; }
 
-  // Targets are keyed by the caller's id; the mesh must have passed makeMesh(). With a worker the
-  // set-up (bounds, BVH, exact distance) runs there: the target is not graspable until
-  // targetSetup() says ready, and a set-up failure is reported once by takeSetupFailures().
+  // Targets are keyed by the caller's id; the arrays need only have passed the checks one
+  // streaming pass makes (counts, finite coordinates, indices in range): the set-up (the rest of
+  // validateMesh, the winding, bounds, BVH, exact distance) runs on the worker. The target is not
+  // graspable until targetSetup() says ready; a set-up failure is reported once by
+  // takeSetupFailures().
   Status addTarget(uint64_t id, TriangleMesh mesh);
-  // ready for targets set up in addTarget (caller threading) and device targets.
+  // ready for device targets at once.
   TargetSetup targetSetup(uint64_t id) const;
-  // What each set-up finished since the last call found of its mesh's winding (addTarget turns
-  // every part outward, on the worker when there is one), for the owner to report once.
+  // What each set-up finished since the last call found of its mesh's winding (the worker turns
+  // every part outward), for the owner to report once.
   std::vector<std::pair<uint64_t, MeshOrientation>> takeSetupOrientations();
   // Targets whose set-up failed since the last call, with the reason (each reported once).
   std::vector<std::pair<uint64_t, std::string>> takeSetupFailures();
-  // With a worker: targets whose new vertices the worker refused since the last call (a triangle
-  // collapsed to zero area), with the reason. The target keeps its last accepted shape; a run of
-  // refused updates is reported once, at its first.
+  // Targets whose new vertices the worker refused since the last call (a triangle collapsed to
+  // zero area), with the reason. The target keeps its last accepted shape; a run of refused
+  // updates is reported once, at its first.
   std::vector<std::pair<uint64_t, std::string>> takeRefusedUpdates();
-  // With a worker: waits until it has nothing queued or running, at most `timeout` (tests and
-  // tools only; false on timeout). True at once without one.
+  // Waits until the worker has nothing queued or running, at most `timeout` (tests and tools
+  // only; false on timeout).
   bool waitWorkerIdle(std::chrono::milliseconds timeout) const;
-  bool usesWorker() const { return worker_ != nullptr; }
   // A target whose mesh exists only in the deferred backend (registered there under `id`, e.g.
   // the app's Vulkan buffers). `bounds` (target frame) must contain the mesh at all times; it
   // decides whether the target is in a grab box. Errors: invalid_argument (id in use, bad
@@ -171,10 +169,10 @@ class GraspSession {
   // id).
   Status setTargetHands(uint64_t id, bool left, bool right);
   // The same, handing over `positions` and their bounds (computed by the caller while it filled
-  // them): with a worker nothing is copied. Fill a buffer from vertexBuffer() to allocate nothing.
+  // them): nothing is copied. Fill a buffer from vertexBuffer() to allocate nothing.
   Status updateTargetVertices(uint64_t id, std::vector<glm::vec3>&& positions, const Aabb& bounds);
   // A buffer the worker is done with, sized for target `id`'s positions when it has one (empty
-  // without a worker or before the first update).
+  // before the first update).
   std::vector<glm::vec3> vertexBuffer(uint64_t id);
   // Removes the target; a hand holding it lets go. Returns false for an unknown id.
   bool removeTarget(uint64_t id);
@@ -218,21 +216,19 @@ class GraspSession {
 
  private:
   struct Target {
-    std::unique_ptr<MeshDistance> distance;  // null for device targets and with a worker
-    bool meshTarget = false;                 // CPU arrays (addTarget), not device buffers
+    bool meshTarget = false;  // CPU arrays (addTarget), not device buffers
     TargetSetup setup = TargetSetup::ready;
-    // With a worker and a deferred backend that builds mesh targets: the arrays it uploads.
+    // With a deferred backend that builds mesh targets: the arrays it uploads.
     std::unique_ptr<TriangleMesh> deviceCopy;
-    size_t vertexCount = 0;  // with a worker: what updateTargetVertices must match
+    size_t vertexCount = 0;  // what updateTargetVertices must match
     Aabb bounds;
     uint64_t version = 0;
     std::array<bool, 2> hands{true, true};  // graspable by the left, the right hand
   };
   struct HandState {
     HandModel model;
-    std::unique_ptr<GraspSolver> solver;
-    // With a worker: the solver it prepares and solves with (replaced, never changed, by the
-    // owner once handed over).
+    // The solver the worker prepares and solves with (replaced, never changed, by the owner once
+    // handed over).
     std::shared_ptr<GraspWorker::SolverSetup> workerSolver;
     bool prepared = false;
     HandGrasp grasp;
@@ -267,11 +263,8 @@ class GraspSession {
 
   Status solve(HandState& hand, size_t slot, uint64_t id, const Target& target,
                const Pose& objectFromHand);
-  // `exactMesh`: the target's mesh for the exact check and the contacts (null: none); `time`:
-  // the HandFrame::time the pose came from.
-  Status solveWithGrid(HandState& hand, const Pose& objectFromHand, uint64_t version, bool gpu,
-                       const MeshDistance* exactMesh, int64_t time);
-  // Collects the hand's deferred build, if any; on a device failure redoes it on the CPU.
+  // Collects the hand's deferred build, if any, for the worker to solve on; on a device failure
+  // has the worker redo it on the CPU.
   Status collect(HandState& hand, size_t slot);
   // Takes the worker's finished job for the hand, if any.
   Status collectJob(HandState& hand, size_t slot);
@@ -290,7 +283,6 @@ class GraspSession {
   std::optional<uint64_t> pickTarget(Hand side, const Pose& worldFromWrist,
                                      std::span<const TargetFrame> targets) const;
 
-  std::unique_ptr<SdfBackend> backend_;
   std::unique_ptr<DeferredSdfBackend> deferred_;
   bool deferredForMeshTargets_ = true;
   SdfBuildStats stats_;

@@ -38,6 +38,7 @@ GraspWorker::~GraspWorker() {
     std::lock_guard lock(mutex_);
     stop_ = true;
     for (auto& flag : stopBuild_) flag.store(true, std::memory_order_relaxed);
+    for (auto& [id, target] : targets_) target->stop.store(true, std::memory_order_relaxed);
   }
   wake_.notify_all();
   thread_.join();
@@ -48,7 +49,9 @@ void GraspWorker::addTarget(uint64_t id, TriangleMesh mesh) {
   t->setupMesh = std::move(mesh);
   {
     std::lock_guard lock(mutex_);
-    targets_[id] = std::move(t);
+    std::shared_ptr<Target>& slot = targets_[id];
+    if (slot != nullptr) slot->stop.store(true, std::memory_order_relaxed);  // replaced
+    slot = std::move(t);
     setups_.push_back(id);
   }
   wake_.notify_all();
@@ -81,6 +84,7 @@ void GraspWorker::removeTarget(uint64_t id) {
     auto it = targets_.find(id);
     if (it == targets_.end()) return;
     dropped = std::move(it->second);
+    dropped->stop.store(true, std::memory_order_relaxed);
     targets_.erase(it);
     // A build for it is of no use to anyone now.
     for (size_t slot = 0; slot < kSlots; ++slot)
@@ -227,25 +231,31 @@ void GraspWorker::runSetup(std::unique_lock<std::mutex>& lock, uint64_t id,
   Aabb bounds;
   MeshOrientation orientation;
   std::shared_ptr<const std::vector<uint32_t>> orientedIndices;
+  // Every step looks at the target's stop flag (removed, replaced, or the worker destroyed).
+  const WorkLimit limit{WorkLimit::Clock::time_point::max(), &target->stop};
   try {
     // The app's thread checked counts, coordinates and indices in its one copying pass; the
     // triangles' areas (a gather over the whole mesh, milliseconds for 400k triangles) are
     // checked here, before the winding vote reads them.
-    if (auto refused = validateMesh(mesh.positions, mesh.indices)) {
+    if (auto refused = validateMesh(mesh.positions, mesh.indices, limit)) {
       error = refused->message;
     } else {
       bounds = computeBounds(mesh.positions);
       // Meshes come wound either way, or both: the SDF's sign needs outward triangles. An open
       // part's winding-number vote costs O(samples x triangles), so it runs here, not in the
       // app's create call.
-      orientation = orientOutward(mesh.positions, mesh.indices);
-      if (orientation.flipped > 0)
-        orientedIndices = std::make_shared<const std::vector<uint32_t>>(mesh.indices);
-      auto made = MeshDistance::create(mesh);
-      if (made)
-        distance = std::move(*made);
-      else
-        error = made.error().message;
+      orientation = orientOutward(mesh.positions, mesh.indices, limit);
+      if (orientation.stopped) {
+        error = "the set-up was stopped";
+      } else {
+        if (orientation.flipped > 0)
+          orientedIndices = std::make_shared<const std::vector<uint32_t>>(mesh.indices);
+        auto made = MeshDistance::create(mesh, limit);
+        if (made)
+          distance = std::move(*made);
+        else
+          error = made.error().message;
+      }
     }
   } catch (const std::bad_alloc&) {
     error = "out of memory";
@@ -256,7 +266,7 @@ void GraspWorker::runSetup(std::unique_lock<std::mutex>& lock, uint64_t id,
   // deforming target neither allocate nor fault in fresh pages on the app's thread: the set-up's
   // own positions, already in memory, and one more.
   std::vector<std::vector<glm::vec3>> spares;
-  if (distance != nullptr) {
+  if (distance != nullptr && !target->stop.load(std::memory_order_relaxed)) {
     try {
       spares.push_back(std::move(mesh.positions));
       spares.emplace_back(spares.front().size());
@@ -331,9 +341,16 @@ void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job jo
     if (distance != nullptr && positions) {
       // A deformed mesh: refit the hierarchy (O(n)). Positions that collapse a triangle are
       // refused by updatePositions, which leaves the last shape whole: the hand goes on with it.
-      if (distance->updatePositions(*positions) == Status::ok) {
+      const Status refit = distance->updatePositions(
+          *positions, WorkLimit{WorkLimit::Clock::time_point::max(), &target->stop});
+      if (refit == Status::ok) {
         refitBounds = computeBounds(*positions);
         target->lastUpdateRefused = false;
+      } else if (refit == Status::timed_out) {
+        // The target is being dropped (removed, or the worker destroyed): the half-refit object
+        // goes with it; nothing is built on it.
+        distance = nullptr;
+        done.status = Status::timed_out;
       } else if (!target->lastUpdateRefused) {
         target->lastUpdateRefused = true;
         auto why = findDegenerateTriangle(*positions, distance->mesh().indices);

@@ -13,13 +13,15 @@
 //   queue never grows); take() returns the newest finished result of a slot, if any, at once.
 // Set-ups run before hand jobs; the two slots take turns.
 //
-// Lifecycle: the destructor sets a stop flag, wakes the thread and joins it; a grab-box build
-// running then stops at its next row of nodes (WorkLimit), a set-up runs to its end (its
-// MeshDistance::create: about a second for a million triangles), queued work is dropped. A build
-// also stops when its slot is cancelled or its target removed, and when it passes the job's
-// buildTimeLimit (its result then says timed_out). Removing a target while a job
-// reads it is safe: the job holds its own reference. A job that throws (out of memory) or fails
-// reports its status in its result; the worker carries on.
+// Lifecycle: the destructor sets its stop flags, wakes the thread and joins it, and queued work
+// is dropped. Whatever runs then stops at its next look at a WorkLimit: a grab-box build at its
+// next row of nodes, a set-up (the mesh check, the winding, MeshDistance::create) or a refit
+// within a few thousand triangles, so the join takes milliseconds, not the second a set-up of a
+// million triangles takes (docs/threading.md gives the measured bound). A build also stops when
+// its slot is cancelled or its target removed, and when it passes the job's buildTimeLimit (its
+// result then says timed_out); a set-up or refit stops when its target is removed. Removing a
+// target while a job reads it is safe: the job holds its own reference. A job that throws (out
+// of memory) or fails reports its status in its result; the worker carries on.
 // Thread-safe: every public function may be called from any thread, while the worker runs.
 #pragma once
 
@@ -161,6 +163,9 @@ class GraspWorker {
 
  private:
   struct Target {
+    // Set when the target is removed or replaced, or the worker is destroyed: its set-up or
+    // refit in flight stops (the object is dropped, so a half-refit one is never used again).
+    std::atomic<bool> stop{false};
     std::shared_ptr<MeshDistance> distance;           // touched by the worker thread only
     std::optional<TriangleMesh> setupMesh;            // waiting for its set-up
     std::optional<std::vector<glm::vec3>> positions;  // waiting for the next build

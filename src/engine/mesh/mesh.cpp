@@ -7,10 +7,20 @@
 #include <glm/geometric.hpp>
 
 namespace sdfg {
+namespace {
+
+Error stopped() {
+  return makeError(Status::timed_out, "mesh: the check was stopped");
+}
+
+}  // namespace
 
 std::optional<Error> findDegenerateTriangle(std::span<const glm::vec3> positions,
-                                            std::span<const uint32_t> indices) {
+                                            std::span<const uint32_t> indices,
+                                            const WorkLimit& limit) {
+  LimitPoll poll(limit);
   for (size_t t = 0; t < indices.size() / 3; ++t) {
+    if (poll.reached()) return stopped();
     const uint32_t a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
     if (a == b || b == c || a == c) {
       return makeError(Status::invalid_argument, "mesh: triangle " + std::to_string(t) +
@@ -30,7 +40,8 @@ std::optional<Error> findDegenerateTriangle(std::span<const glm::vec3> positions
 }
 
 std::optional<Error> validateMesh(std::span<const glm::vec3> positions,
-                                  std::span<const uint32_t> indices) {
+                                  std::span<const uint32_t> indices, const WorkLimit& limit) {
+  LimitPoll poll(limit);
   if (positions.empty() || indices.empty()) {
     return makeError(Status::invalid_argument, "mesh: empty (" + std::to_string(positions.size()) +
                                                    " vertices, " + std::to_string(indices.size()) +
@@ -42,6 +53,7 @@ std::optional<Error> validateMesh(std::span<const glm::vec3> positions,
         "mesh: index count " + std::to_string(indices.size()) + " is not a multiple of 3");
   }
   for (size_t v = 0; v < positions.size(); ++v) {
+    if (poll.reached()) return stopped();
     const glm::vec3& p = positions[v];
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
       return makeError(Status::invalid_argument,
@@ -49,6 +61,7 @@ std::optional<Error> validateMesh(std::span<const glm::vec3> positions,
     }
   }
   for (size_t i = 0; i < indices.size(); ++i) {
+    if (poll.reached()) return stopped();
     if (indices[i] >= positions.size()) {
       return makeError(Status::invalid_argument,
                        "mesh: index " + std::to_string(i) + " (triangle " + std::to_string(i / 3) +
@@ -56,7 +69,7 @@ std::optional<Error> validateMesh(std::span<const glm::vec3> positions,
                            std::to_string(positions.size()) + " vertices");
     }
   }
-  return findDegenerateTriangle(positions, indices);
+  return findDegenerateTriangle(positions, indices, limit);
 }
 
 Result<TriangleMesh> makeMesh(std::span<const glm::vec3> positions,

@@ -14,6 +14,7 @@
 
 #include "base/pose.h"
 #include "base/status.h"
+#include "base/work_limit.h"
 
 namespace sdfg {
 
@@ -35,13 +36,17 @@ struct Aabb {
 // Checks arrays before anything is built. Returns the first problem found, naming the element:
 // empty mesh, index count not a multiple of 3, NaN or infinite coordinate, index out of range,
 // degenerate triangle (two equal indices, or zero area). Returns nothing when the mesh is valid.
+// `limit` is polled every few thousand elements; once reached the check stops with an error of
+// code timed_out (a mesh of 2^24 vertices takes a good fraction of a second).
 std::optional<Error> validateMesh(std::span<const glm::vec3> positions,
-                                  std::span<const uint32_t> indices);
+                                  std::span<const uint32_t> indices,
+                                  const WorkLimit& limit = WorkLimit::none());
 
 // The degenerate-triangle part of validateMesh() alone, for new positions of a topology already
 // validated (indices in range): the first triangle that repeats a vertex or has zero area.
 std::optional<Error> findDegenerateTriangle(std::span<const glm::vec3> positions,
-                                            std::span<const uint32_t> indices);
+                                            std::span<const uint32_t> indices,
+                                            const WorkLimit& limit = WorkLimit::none());
 
 // Validates and copies the arrays into a mesh. Nothing is built when validation fails.
 Result<TriangleMesh> makeMesh(std::span<const glm::vec3> positions,

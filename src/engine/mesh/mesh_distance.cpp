@@ -13,6 +13,7 @@
 #include <glm/mat3x3.hpp>
 #include <glm/matrix.hpp>
 
+#include "base/polled_sort.h"
 #include "mesh/triangle_bvh.h"
 
 namespace sdfg {
@@ -83,36 +84,41 @@ struct MeshDistance::Impl {
   mutable std::atomic<bool> clustersReady{false};
   mutable std::mutex clustersMutex;
 
-  void buildTopology();
-  void computeNormals();
-  void computeClusters() const;
+  // Each returns false once `limit` is reached (the object is then given up).
+  bool buildTopology(const WorkLimit& limit);
+  bool computeNormals(const WorkLimit& limit);
+  bool computeClusters(const WorkLimit& limit) const;
   void ensureClusters() const;
   double winding(const glm::vec3& p) const;
   float sign(const glm::vec3& p, const TriangleBvh::Hit& hit) const;
 };
 
-void MeshDistance::Impl::buildTopology() {
+bool MeshDistance::Impl::buildTopology(const WorkLimit& limit) {
   const size_t triangles = mesh.triangleCount();
   struct HalfEdge {
     uint64_t key;   // (min vertex, max vertex)
     uint32_t slot;  // 3 * triangle + edge
   };
   std::vector<HalfEdge> halfEdges(3 * triangles);
+  LimitPoll poll(limit);
   for (size_t t = 0; t < triangles; ++t) {
+    if (poll.reached()) return false;
     for (uint32_t e = 0; e < 3; ++e) {
       const uint32_t u = mesh.indices[3 * t + e], v = mesh.indices[3 * t + (e + 1) % 3];
       const uint64_t key = (uint64_t(std::min(u, v)) << 32) | std::max(u, v);
       halfEdges[3 * t + e] = {key, uint32_t(3 * t + e)};
     }
   }
-  std::sort(halfEdges.begin(), halfEdges.end(),
-            [](const HalfEdge& x, const HalfEdge& y) { return x.key < y.key; });
+  if (!polledSort(
+          halfEdges, [](const HalfEdge& x, const HalfEdge& y) { return x.key < y.key; }, limit))
+    return false;
 
   triangleEdge.assign(3 * triangles, 0);
   edgeCount = 0;
   closed = true;
   bool oriented = true;
   for (size_t i = 0; i < halfEdges.size();) {
+    if (poll.reached()) return false;
     size_t j = i;
     while (j < halfEdges.size() && halfEdges[j].key == halfEdges[i].key) {
       triangleEdge[halfEdges[j].slot] = edgeCount;
@@ -130,14 +136,17 @@ void MeshDistance::Impl::buildTopology() {
     i = j;
   }
   pseudoNormalSign = closed && oriented;
+  return true;
 }
 
-void MeshDistance::Impl::computeNormals() {
+bool MeshDistance::Impl::computeNormals(const WorkLimit& limit) {
   const size_t triangles = mesh.triangleCount();
   faceNormal.resize(triangles);
   edgeNormal.assign(edgeCount, glm::dvec3(0.0));
   vertexNormal.assign(mesh.vertexCount(), glm::dvec3(0.0));
+  LimitPoll poll(limit);
   for (size_t t = 0; t < triangles; ++t) {
+    if (poll.reached()) return false;
     const uint32_t* tri = &mesh.indices[3 * t];
     const glm::dvec3 p[3] = {glm::dvec3(mesh.positions[tri[0]]), glm::dvec3(mesh.positions[tri[1]]),
                              glm::dvec3(mesh.positions[tri[2]])};
@@ -152,14 +161,17 @@ void MeshDistance::Impl::computeNormals() {
       vertexNormal[tri[e]] += angle * n;
     }
   }
+  return true;
 }
 
-void MeshDistance::Impl::computeClusters() const {
+bool MeshDistance::Impl::computeClusters(const WorkLimit& limit) const {
   const auto nodes = bvh.nodes();
   const auto corners = bvh.corners();
   std::vector<Cluster> full(nodes.size());
+  LimitPoll poll(limit, 1024);  // a node costs up to a leaf's triangles of double arithmetic
   // Children follow their parents in the node array: a backward pass builds bottom-up.
   for (size_t i = nodes.size(); i-- > 0;) {
+    if (poll.reached()) return false;
     const TriangleBvh::Node& node = nodes[i];
     Cluster& c = full[i];
     if (node.count > 0) {
@@ -216,6 +228,7 @@ void MeshDistance::Impl::computeClusters() const {
   // Fold the moments into the polynomial coefficients of FarField (see winding()).
   clusters.assign(nodes.size(), FarField{});
   for (size_t i = 0; i < nodes.size(); ++i) {
+    if (poll.reached()) return false;
     const Cluster& c = full[i];
     FarField& f = clusters[i];
     f.center = c.center;
@@ -266,6 +279,7 @@ void MeshDistance::Impl::computeClusters() const {
       }
     }
   }
+  return true;
 }
 
 double MeshDistance::Impl::winding(const glm::vec3& pf) const {
@@ -320,7 +334,7 @@ void MeshDistance::Impl::ensureClusters() const {
   if (clustersReady.load(std::memory_order_acquire)) return;
   std::lock_guard lock(clustersMutex);
   if (clustersReady.load(std::memory_order_relaxed)) return;
-  computeClusters();
+  computeClusters(WorkLimit::none());
   clustersReady.store(true, std::memory_order_release);
 }
 
@@ -357,28 +371,33 @@ float MeshDistance::Impl::sign(const glm::vec3& p, const TriangleBvh::Hit& hit) 
 MeshDistance::MeshDistance(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 MeshDistance::~MeshDistance() = default;
 
-Result<std::unique_ptr<MeshDistance>> MeshDistance::create(const TriangleMesh& mesh) {
-  if (auto error = validateMesh(mesh.positions, mesh.indices)) return *error;
+Result<std::unique_ptr<MeshDistance>> MeshDistance::create(const TriangleMesh& mesh,
+                                                           const WorkLimit& limit) {
+  if (auto error = validateMesh(mesh.positions, mesh.indices, limit)) return *error;
+  const Error stopped = makeError(Status::timed_out, "mesh distance: the set-up was stopped");
   auto impl = std::make_unique<Impl>();
   impl->mesh = mesh;
-  impl->bvh.build(impl->mesh.positions, impl->mesh.indices);
-  impl->buildTopology();
-  impl->computeNormals();
-  if (!impl->pseudoNormalSign) impl->ensureClusters();
+  if (!impl->bvh.build(impl->mesh.positions, impl->mesh.indices, 4, limit)) return stopped;
+  if (!impl->buildTopology(limit) || !impl->computeNormals(limit)) return stopped;
+  if (!impl->pseudoNormalSign) {
+    if (!impl->computeClusters(limit)) return stopped;
+    impl->clustersReady.store(true, std::memory_order_release);
+  }
   return std::unique_ptr<MeshDistance>(new MeshDistance(std::move(impl)));
 }
 
-Status MeshDistance::updatePositions(std::span<const glm::vec3> positions) {
+Status MeshDistance::updatePositions(std::span<const glm::vec3> positions, const WorkLimit& limit) {
   Impl& m = *impl_;
   if (positions.size() != m.mesh.positions.size()) return Status::invalid_argument;
   // Same checks as creation (finite coordinates, no triangle collapsing to zero area), made
   // before anything is touched so a rejected update leaves the old state whole.
-  if (validateMesh(positions, m.mesh.indices)) return Status::invalid_argument;
+  if (auto error = validateMesh(positions, m.mesh.indices, limit)) return error->code;
   std::copy(positions.begin(), positions.end(), m.mesh.positions.begin());
-  m.bvh.refit(m.mesh.positions, m.mesh.indices);
-  m.computeNormals();
+  if (!m.bvh.refit(m.mesh.positions, m.mesh.indices, limit) || !m.computeNormals(limit))
+    return Status::timed_out;
   // Queries never run during an update (the caller owns the object), so a plain rebuild is safe.
-  if (m.clustersReady.load(std::memory_order_relaxed)) m.computeClusters();
+  if (m.clustersReady.load(std::memory_order_relaxed) && !m.computeClusters(limit))
+    return Status::timed_out;
   return Status::ok;
 }
 

@@ -15,6 +15,7 @@
 #include <glm/vec3.hpp>
 
 #include "base/status.h"
+#include "base/work_limit.h"
 #include "mesh/mesh.h"
 
 namespace sdfg {
@@ -27,15 +28,23 @@ struct ClosestPoint {
 
 class MeshDistance {
  public:
-  // Takes its own copy of the mesh. Fails only on an invalid mesh (see validateMesh).
-  static Result<std::unique_ptr<MeshDistance>> create(const TriangleMesh& mesh);
+  // Takes its own copy of the mesh. Fails on an invalid mesh (see validateMesh), and with
+  // timed_out once `limit` is reached: every step (the check, the hierarchy, the sort of the
+  // edges, the normals, the winding-number clusters) looks at it every few thousand elements, so
+  // a set-up of a million triangles (about a second) stops within milliseconds of being asked.
+  static Result<std::unique_ptr<MeshDistance>> create(const TriangleMesh& mesh,
+                                                      const WorkLimit& limit = WorkLimit::none());
   ~MeshDistance();
   MeshDistance(const MeshDistance&) = delete;
   MeshDistance& operator=(const MeshDistance&) = delete;
 
   // New vertex positions, same count and topology (animated or skinned meshes). Refits the
-  // hierarchy's bounds and recomputes pseudo-normals in O(n); no rebuild.
-  Status updatePositions(std::span<const glm::vec3> positions);
+  // hierarchy's bounds and recomputes pseudo-normals in O(n); no rebuild. A refused update
+  // (invalid_argument) changes nothing. Once `limit` is reached it returns timed_out: during the
+  // check nothing has changed yet, later the object is left half updated and must not be used
+  // again (the worker passes a limit only to stop work whose target is being dropped).
+  Status updatePositions(std::span<const glm::vec3> positions,
+                         const WorkLimit& limit = WorkLimit::none());
 
   const TriangleMesh& mesh() const;
   // True when every edge has exactly two triangles (no boundary, no non-manifold edge).

@@ -21,6 +21,8 @@
 
 #include <glm/vec3.hpp>
 
+#include "base/work_limit.h"
+
 namespace sdfg {
 
 struct MeshOrientation {
@@ -29,6 +31,9 @@ struct MeshOrientation {
   uint32_t inconsistent = 0;        // triangles flipped to agree with their part's neighbours
   uint32_t invertedComponents = 0;  // parts that faced inwards and were flipped whole
   uint32_t flipped = 0;             // triangles flipped in all
+  // The WorkLimit was reached before the end: `indices` were left as given, the counts are
+  // incomplete.
+  bool stopped = false;
   // What the app gave, in words: "counter-clockwise (outward)", "clockwise (inside-out)" or
   // "mixed".
   const char* describe() const;
@@ -37,8 +42,10 @@ struct MeshOrientation {
 // Rewrites `indices` (three per triangle, into `positions`) so every part faces outward, and says
 // what it found. Cost: O(triangles) for the walk and the volumes, plus O(samples x triangles)
 // for each open part (at most 16 samples per part). `indices` must be a valid triangle list
-// (size a multiple of 3, every index < positions.size(); as after validateMesh()).
-MeshOrientation orientOutward(std::span<const glm::vec3> positions, std::vector<uint32_t>& indices);
+// (size a multiple of 3, every index < positions.size(); as after validateMesh()). `limit` is
+// polled every few thousand triangles (an open part's vote alone reads every triangle 32 times).
+MeshOrientation orientOutward(std::span<const glm::vec3> positions, std::vector<uint32_t>& indices,
+                              const WorkLimit& limit = WorkLimit::none());
 
 // The generalized winding number of the triangles at `p` (sum of their solid angles / 4 pi):
 // ~1 inside a closed outward mesh, ~0 outside, ~-1 inside an inside-out one.

@@ -92,24 +92,35 @@ inline float boxDistanceSquared(const glm::vec3& p, const glm::vec3& mn, const g
 
 }  // namespace
 
-void TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
-                        uint32_t maxLeafSize) {
+void TriangleBvh::clear() {
+  nodes_.clear();
+  order_.clear();
+  corners_.clear();
+  frames_.clear();
+  slotOf_.clear();
+  slabs_.clear();
+}
+
+bool TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
+                        uint32_t maxLeafSize, const WorkLimit& limit) {
   const size_t n = indices.size() / 3;
   maxLeafSize = std::max(maxLeafSize, 1u);
-  nodes_.clear();
+  clear();
+  if (n == 0) return true;
   order_.resize(n);
   std::iota(order_.begin(), order_.end(), 0u);
-  if (n == 0) {
-    corners_.clear();
-    frames_.clear();
-    slotOf_.clear();
-    slabs_.clear();
-    return;
-  }
+  // Polled per triangle in every loop below (the root alone bins and partitions all of them),
+  // so the time between two looks at the limit stays bounded whatever the mesh.
+  LimitPoll poll(limit);
+  const auto stop = [this] {
+    clear();
+    return false;
+  };
 
   std::vector<Box> triBox(n);
   std::vector<glm::vec3> centroid(n);
   for (size_t t = 0; t < n; ++t) {
+    if (poll.reached()) return stop();
     for (int k = 0; k < 3; ++k) triBox[t].grow(positions[indices[3 * t + k]]);
     centroid[t] = triBox[t].min * 0.5f + triBox[t].max * 0.5f;
   }
@@ -129,7 +140,10 @@ void TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const ui
     if (count <= maxLeafSize) continue;
 
     Box centroidBox;
-    for (uint32_t s = first; s < first + count; ++s) centroidBox.grow(centroid[order_[s]]);
+    for (uint32_t s = first; s < first + count; ++s) {
+      if (poll.reached()) return stop();
+      centroidBox.grow(centroid[order_[s]]);
+    }
 
     // Binned SAH over all three axes: the split with the least
     // area(left) * count(left) + area(right) * count(right).
@@ -143,6 +157,7 @@ void TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const ui
         std::array<Box, kBins> bins{};
         std::array<uint32_t, kBins> counts{};
         for (uint32_t s = first; s < first + count; ++s) {
+          if (poll.reached()) return stop();
           const uint32_t t = order_[s];
           const int bin = std::min(kBins - 1, int((centroid[t][axis] - lo) * scale));
           bins[bin].grow(triBox[t]);
@@ -176,11 +191,29 @@ void TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const ui
     if (bestAxis >= 0) {
       const float lo = centroidBox.min[bestAxis];
       const float scale = float(kBins) / (centroidBox.max[bestAxis] - lo);
-      const auto it =
-          std::partition(order_.begin() + first, order_.begin() + first + count, [&](uint32_t t) {
-            return std::min(kBins - 1, int((centroid[t][bestAxis] - lo) * scale)) < bestSplit;
-          });
-      mid = uint32_t(it - order_.begin());
+      const auto left = [&](uint32_t t) {
+        return std::min(kBins - 1, int((centroid[t][bestAxis] - lo) * scale)) < bestSplit;
+      };
+      // std::partition written out so that it can poll: the same swaps from both ends as
+      // libstdc++'s, so the tree (and which of two equally close triangles a query reports) is
+      // the one it always was.
+      uint32_t from = first, to = first + count;
+      for (;;) {
+        while (from != to && left(order_[from])) {
+          if (poll.reached()) return stop();
+          ++from;
+        }
+        if (from == to) break;
+        --to;
+        while (from != to && !left(order_[to])) {
+          if (poll.reached()) return stop();
+          --to;
+        }
+        if (from == to) break;
+        std::swap(order_[from], order_[to]);
+        ++from;
+      }
+      mid = from;
     } else {
       // All centroids coincide (or the tree is too deep): any split by count is as good.
       mid = first + count / 2;
@@ -198,11 +231,15 @@ void TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const ui
   for (uint32_t s = 0; s < n; ++s) slotOf_[order_[s]] = s;
   corners_.resize(n);
   frames_.resize(n);
-  refit(positions, indices);
+  if (!refit(positions, indices, limit)) return stop();
+  return true;
 }
 
-void TriangleBvh::refit(std::span<const glm::vec3> positions, std::span<const uint32_t> indices) {
+bool TriangleBvh::refit(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
+                        const WorkLimit& limit) {
+  LimitPoll poll(limit);
   for (size_t s = 0; s < order_.size(); ++s) {
+    if (poll.reached()) return false;
     const uint32_t t = order_[s];
     corners_[s] = {positions[indices[3 * t]], positions[indices[3 * t + 1]],
                    positions[indices[3 * t + 2]]};
@@ -219,13 +256,14 @@ void TriangleBvh::refit(std::span<const glm::vec3> positions, std::span<const ui
                   glm::vec3(glm::cross(n, ca)),
                   float(1.0 / glm::dot(ca, ca))};
   }
-  refitNodes();
+  return refitNodes(poll);
 }
 
-void TriangleBvh::refitNodes() {
+bool TriangleBvh::refitNodes(LimitPoll& poll) {
   std::vector<uint32_t> triangles(nodes_.size());  // in each node's subtree
   // Children follow their parent, so one backward pass sees children before parents.
   for (size_t i = nodes_.size(); i-- > 0;) {
+    if (poll.reached()) return false;
     Node& node = nodes_[i];
     Box box;
     if (node.count > 0) {
@@ -253,6 +291,7 @@ void TriangleBvh::refitNodes() {
   std::vector<double> areaTotal(nodes_.size());    // sum of their lengths
   constexpr float kInf = std::numeric_limits<float>::infinity();
   for (size_t i = nodes_.size(); i-- > 0;) {
+    if (poll.reached()) return false;
     const Node& node = nodes_[i];
     Slab& slab = slabs_[i];
     slab.lo = -kInf;
@@ -332,6 +371,7 @@ void TriangleBvh::refitNodes() {
     slab.hi = float(hi + pad);
     slab.radius = float(radius + pad);
   }
+  return true;
 }
 
 // Inlined into closest(): it runs twice per inner node visited, over a hundred times a query.

@@ -22,6 +22,8 @@
 
 #include <glm/vec3.hpp>
 
+#include "base/work_limit.h"
+
 namespace sdfg {
 
 // Which part of a triangle (a, b, c) holds the closest point. Edge i joins vertex i and vertex
@@ -65,13 +67,17 @@ class TriangleBvh {
 
   // Builds over `indices` (three per triangle) into `positions`. The arrays must describe a
   // valid mesh (validateMesh); they are not kept, only copied per triangle in leaf order.
-  void build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
-             uint32_t maxLeafSize = 4);
+  // `limit` is polled every few thousand triangles; once it is reached the build stops, returns
+  // false and leaves an empty tree (a million triangles take about a second to build).
+  bool build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
+             uint32_t maxLeafSize = 4, const WorkLimit& limit = WorkLimit::none());
 
   // New positions for the same triangles (same indices as build()): recomputes the node bounds
   // bottom-up, O(n). The tree shape stays, so queries stay exact but may slow down after large
-  // deformations.
-  void refit(std::span<const glm::vec3> positions, std::span<const uint32_t> indices);
+  // deformations. Stopped by `limit` (false), the tree is left half refit: not to be queried
+  // again (its owner is dropping it).
+  bool refit(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
+             const WorkLimit& limit = WorkLimit::none());
 
   // Closest triangle to `p` among those nearer than sqrt(seed.distanceSquared); returns `seed`
   // unchanged when none is. A default seed searches everything. A seed carrying a triangle must
@@ -107,7 +113,8 @@ class TriangleBvh {
   size_t triangleCount() const { return order_.size(); }
 
  private:
-  void refitNodes();
+  bool refitNodes(LimitPoll& poll);
+  void clear();
   // Lower bound on the squared distance from `p` to node i's triangles: its box, and its slab
   // unless the box alone reaches `best` (then the node is pruned anyway).
   float nodeDistanceSquared(const glm::vec3& p, uint32_t i, double best) const;

@@ -1,0 +1,305 @@
+// The layer's grab update, once per sync of its action set: gather, hand over, publish.
+//
+// 1. Gather, no lock held: the squeeze of each hand (xrGetActionStateFloat), the hand (the
+//    layer's own hand tracker on the runtime, else the grip pose), the pose of every placed target
+//    (xrLocateSpace). The spaces of the targets are marked in use first, so an xrDestroySpace on
+//    another thread waits for these calls instead of the layer passing a destroyed space down.
+// 2. Hand over, under the session's lock (microseconds, no call out): the engine's update per
+//    hand, the grasp events, the offsets, and a ShownHand per hand published for
+//    xrLocateHandJointsEXT.
+// 3. After the unlock: the log lines of what the update found, then the GPU pump (the device
+//    calls of builds the update recorded).
+#include <cmath>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "grasp/tracked_squeeze.h"
+#include "intercepts.h"
+#include "log.h"
+#include "state.h"
+
+namespace sdfg::layer {
+namespace {
+
+constexpr XrSpaceLocationFlags kValidBits =
+    XR_SPACE_LOCATION_ORIENTATION_VALID_BIT | XR_SPACE_LOCATION_POSITION_VALID_BIT;
+
+// Locates `space` in `base`; nothing unless position and orientation are valid.
+std::optional<Pose> locate(const InstanceState& inst, XrSpace space, XrSpace base, XrTime time) {
+  if (space == XR_NULL_HANDLE || base == XR_NULL_HANDLE) return std::nullopt;
+  XrSpaceLocation loc{XR_TYPE_SPACE_LOCATION};
+  if (inst.next.xrLocateSpace(space, base, time, &loc) != XR_SUCCESS) return std::nullopt;
+  if ((loc.locationFlags & kValidBits) != kValidBits) return std::nullopt;
+  return toPose(loc.pose);
+}
+
+struct PlacedTarget {
+  uint64_t id = 0;
+  XrSpace space = XR_NULL_HANDLE;
+  XrPosef pose{};
+};
+
+// What the gather needs, copied under the lock.
+struct Plan {
+  XrTime time = 0;
+  XrSpace local = XR_NULL_HANDLE;
+  std::array<XrSpace, 2> grips{};
+  std::array<XrHandTrackerEXT, 2> trackers{};
+  std::array<bool, 2> createTracker{};  // this call asks the runtime for the hand's tracker
+  std::array<bool, 2> tracked{};        // the hand may be tracked by the runtime
+  std::vector<PlacedTarget> targets;    // their spaces are marked in use
+};
+
+// What the runtime said, for the engine.
+struct Gathered {
+  std::array<float, 2> squeeze{};
+  std::array<bool, 2> squeezeActive{};
+  std::array<std::optional<Pose>, 2> grip;  // worldFromGrip
+  std::array<bool, 2> trackedValid{};
+  std::array<JointPoses, 2> joints{};
+  std::array<JointRadii, 2> radii{};
+  std::array<XrHandTrackerEXT, 2> created{};
+  std::array<XrResult, 2> createResult{};
+  std::vector<TargetFrame> targets;
+};
+
+std::optional<Plan> planGather(SessionState& s) {
+  std::lock_guard lock(s.mutex);
+  InstanceState& inst = *s.instance;
+  if (s.predictedTime == 0 || s.grasp == nullptr || s.localSpace == XR_NULL_HANDLE)
+    return std::nullopt;
+  Plan p;
+  p.time = s.predictedTime;
+  p.local = s.localSpace;
+  p.grips = s.gripSpaces;
+  const bool runtimeHands = inst.downstreamHandTracking &&
+                            inst.next.xrLocateHandJointsEXT != nullptr &&
+                            !inst.runtimeSystemLacksHands;
+  for (size_t h = 0; h < 2; ++h) {
+    p.tracked[h] = runtimeHands && !s.internalTrackerRefused[h];
+    if (!p.tracked[h]) continue;
+    p.trackers[h] = s.internalTrackers[h];
+    // One thread asks the runtime for the tracker; a sync on another thread meanwhile does without.
+    if (p.trackers[h] == XR_NULL_HANDLE && !s.internalTrackerCreating[h]) {
+      s.internalTrackerCreating[h] = true;
+      p.createTracker[h] = true;
+    }
+  }
+  p.targets.reserve(s.targets.size());
+  for (const auto& [id, t] : s.targets) {
+    PlacedTarget pt{id, XR_NULL_HANDLE, t->pose};
+    auto use = t->placed ? s.spaces.find(key(t->space)) : s.spaces.end();
+    if (use != s.spaces.end() && !use->second.dying) {
+      ++use->second.users;
+      pt.space = t->space;
+    }
+    p.targets.push_back(pt);
+  }
+  return p;
+}
+
+// The runtime's answers; no lock held. Only handles the plan named are used.
+Gathered gather(SessionState& s, const Plan& p, const char* cmd) {
+  InstanceState& inst = *s.instance;
+  Gathered g;
+  for (size_t h = 0; h < 2; ++h) {
+    XrActionStateGetInfo get{XR_TYPE_ACTION_STATE_GET_INFO};
+    get.action = inst.squeezeAction;
+    get.subactionPath = inst.handPaths[h];
+    XrActionStateFloat state{XR_TYPE_ACTION_STATE_FLOAT};
+    g.squeezeActive[h] =
+        inst.next.xrGetActionStateFloat(s.handle, &get, &state) == XR_SUCCESS && state.isActive;
+    g.squeeze[h] =
+        g.squeezeActive[h] && std::isfinite(state.currentState) ? state.currentState : 0.0f;
+
+    XrHandTrackerEXT tracker = p.trackers[h];
+    if (p.createTracker[h]) {
+      XrHandTrackerCreateInfoEXT info{XR_TYPE_HAND_TRACKER_CREATE_INFO_EXT};
+      info.hand = h == 0 ? XR_HAND_LEFT_EXT : XR_HAND_RIGHT_EXT;
+      info.handJointSet = XR_HAND_JOINT_SET_DEFAULT_EXT;
+      g.createResult[h] = inst.next.xrCreateHandTrackerEXT(s.handle, &info, &g.created[h]);
+      if (g.createResult[h] != XR_SUCCESS) {
+        g.created[h] = XR_NULL_HANDLE;
+        // Remembered for the session (planGather): a refusal is not retried every frame (each
+        // retry is an error line in the runtime's log).
+        SDFG_LOG_INFO(cmd,
+                      "the runtime refused a %s hand tracker (%d); that hand follows the "
+                      "controller",
+                      h == 0 ? "left" : "right", int(g.createResult[h]));
+      }
+      tracker = g.created[h];
+    }
+    if (tracker != XR_NULL_HANDLE) {
+      std::array<XrHandJointLocationEXT, XR_HAND_JOINT_COUNT_EXT> loc{};
+      XrHandJointLocationsEXT locations{XR_TYPE_HAND_JOINT_LOCATIONS_EXT};
+      locations.jointCount = XR_HAND_JOINT_COUNT_EXT;
+      locations.jointLocations = loc.data();
+      XrHandJointsLocateInfoEXT info{XR_TYPE_HAND_JOINTS_LOCATE_INFO_EXT};
+      info.baseSpace = p.local;
+      info.time = p.time;
+      if (inst.next.xrLocateHandJointsEXT(tracker, &info, &locations) == XR_SUCCESS &&
+          locations.isActive) {
+        for (int j = 0; j < kJointCount; ++j) {
+          g.joints[h][size_t(j)] = toPose(loc[size_t(j)].pose);
+          g.radii[h][size_t(j)] = loc[size_t(j)].radius;
+        }
+        g.trackedValid[h] = true;
+      }
+    }
+    if (!g.trackedValid[h]) g.grip[h] = locate(inst, p.grips[h], p.local, p.time);
+  }
+  g.targets.reserve(p.targets.size());
+  for (const PlacedTarget& t : p.targets) {
+    TargetFrame f;
+    f.id = t.id;
+    if (auto located = locate(inst, t.space, p.local, p.time)) {
+      f.valid = true;
+      f.worldFromObject = *located * toPose(t.pose);
+    }
+    g.targets.push_back(f);
+  }
+  return g;
+}
+
+// Ends the plan's uses of spaces and stores the trackers made (`g` null: the gather failed
+// before it was done; a tracker it may have made is not known). Returns whether a space's last use
+// ended. The caller holds the lock.
+bool finishGather(SessionState& s, const Plan& p, const Gathered* g) {
+  bool released = false;
+  for (const PlacedTarget& t : p.targets) {
+    if (t.space == XR_NULL_HANDLE) continue;
+    auto use = s.spaces.find(key(t.space));
+    if (use != s.spaces.end() && --use->second.users == 0) released = true;
+  }
+  for (size_t h = 0; h < 2; ++h) {
+    if (!p.createTracker[h]) continue;
+    s.internalTrackerCreating[h] = false;
+    if (g == nullptr) continue;
+    if (g->created[h] != XR_NULL_HANDLE)
+      s.internalTrackers[h] = g->created[h];
+    else
+      s.internalTrackerRefused[h] = true;
+  }
+  return released;
+}
+
+// What the update found, logged after the unlock.
+struct UpdateReport {
+  std::array<Status, 2> status{Status::ok, Status::ok};
+  std::vector<std::pair<uint64_t, MeshOrientation>> orientations;
+  std::vector<std::pair<uint64_t, std::string>> refusedUpdates;
+  std::vector<std::pair<uint64_t, std::string>> setupFailures;
+};
+
+// The engine's update of both hands. The caller holds the lock; nothing here calls out.
+void updateHands(SessionState& s, const Gathered& g, UpdateReport& report) {
+  for (size_t h = 0; h < 2; ++h) {
+    const Hand hand = h == 0 ? Hand::left : Hand::right;
+    s.squeeze[h] = g.squeeze[h];
+    HandFrame frame;
+    frame.squeeze = g.squeeze[h];
+    frame.time = s.predictedTime;
+    if (g.trackedValid[h]) {
+      frame.valid = true;
+      frame.worldFromWrist = g.joints[h][size_t(Joint::wrist)];
+      frame.trackedJoints = &g.joints[h];
+      frame.trackedRadii = &g.radii[h];
+      if (!g.squeezeActive[h]) {
+        // A tracked hand without a controller grabs by closing.
+        JointPoses local;
+        const Pose wristFromWorld = frame.worldFromWrist.inverse();
+        for (int j = 0; j < kJointCount; ++j)
+          local[size_t(j)] = wristFromWorld * g.joints[h][size_t(j)];
+        frame.squeeze = squeezeFromTrackedHand(s.grasp->model(hand), local);
+      }
+    } else if (g.grip[h]) {
+      frame.valid = true;
+      frame.worldFromWrist = *g.grip[h] * wristFromGrip(s.grasp->model(hand)).inverse();
+    }
+    const HandGrasp& before = s.grasp->grasp(hand);
+    const bool wasGrasping = before.shown();
+    const uint64_t wasTarget = before.target;
+    report.status[h] = s.grasp->update(hand, frame, g.targets);
+    noteGraspChange(s, hand, wasGrasping, wasTarget);
+    HandOffset& offset = s.offsets.hands[h];
+    advanceHandOffset(offset, s.grasp->grasp(hand), s.predictedTime, s.offsets.blendTime);
+  }
+  publishShownHands(s);
+  report.orientations = s.grasp->takeSetupOrientations();
+  report.refusedUpdates = s.grasp->takeRefusedUpdates();
+  report.setupFailures = s.grasp->takeSetupFailures();
+}
+
+void logReport(const InstanceState& inst, const UpdateReport& report, const char* cmd) {
+  for (Status st : report.status) {
+    if (st == Status::timed_out)
+      SDFG_LOG_WARN(cmd,
+                    "the grab's SDF build passed its time bound (build_time_limit_ms = %u); the "
+                    "hand stays open until it is released",
+                    inst.config.buildTimeLimitMs);
+    else if (st != Status::ok)
+      SDFG_LOG_WARN(cmd, "grasp solve failed (%s); the hand stays open until it is released",
+                    toString(st));
+  }
+  // Set-ups run on the session's worker: one line per target on how its mesh was wound, and one
+  // per target whose mesh it could not take.
+  for (const auto& [id, o] : report.orientations) {
+    if (o.flipped > 0)
+      SDFG_LOG_WARN(cmd, "target %#llx: mesh wound %s; %u triangles flipped to face outward",
+                    static_cast<unsigned long long>(id), o.describe(), o.flipped);
+    else
+      SDFG_LOG_INFO(cmd, "target %#llx: mesh wound %s (%u parts, %u closed)",
+                    static_cast<unsigned long long>(id), o.describe(), o.components,
+                    o.closedComponents);
+  }
+  for (const auto& [id, why] : report.refusedUpdates)
+    SDFG_LOG_WARN(
+        "xrUpdateGraspTargetVerticesSDFG",
+        "grasp target 0x%llx: new vertices refused (%s); it keeps its last accepted shape",
+        static_cast<unsigned long long>(id), why.c_str());
+  for (const auto& [id, why] : report.setupFailures)
+    SDFG_LOG_WARN(cmd, "grasp target 0x%llx cannot be grasped: its set-up failed (%s)",
+                  static_cast<unsigned long long>(id), why.c_str());
+}
+
+}  // namespace
+
+void publishShownHands(SessionState& s) {
+  if (s.grasp == nullptr) return;
+  for (size_t h = 0; h < 2; ++h) {
+    const Hand hand = h == 0 ? Hand::left : Hand::right;
+    s.shown[h].store(std::make_shared<const ShownHand>(
+        takeShownHand(*s.grasp, hand, s.offsets.hands[h], s.squeeze[h])));
+  }
+}
+
+void syncGrasps(SessionState& s, const char* cmd) {
+  const std::optional<Plan> plan = planGather(s);
+  if (!plan) return;
+  std::optional<Gathered> gathered;
+  UpdateReport report;
+  bool released = false;
+  try {
+    gathered = gather(s, *plan, cmd);
+  } catch (...) {
+    // The spaces must be released whatever happened (an xrDestroySpace may be waiting).
+    {
+      std::lock_guard lock(s.mutex);
+      finishGather(s, *plan, nullptr);
+    }
+    s.spaceReleased.notify_all();
+    throw;
+  }
+  {
+    std::lock_guard lock(s.mutex);
+    released = finishGather(s, *plan, &*gathered);
+    if (s.grasp != nullptr) updateHands(s, *gathered, report);
+  }
+  if (released) s.spaceReleased.notify_all();
+  logReport(*s.instance, report, cmd);
+  pumpGpu(s, false);
+}
+
+}  // namespace sdfg::layer

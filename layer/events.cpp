@@ -116,7 +116,7 @@ void noteGraspChange(SessionState& s, Hand hand, bool wasGrasping, uint64_t wasT
   InstanceState& inst = *s.instance;
   if (!inst.appAutoGrasp || s.grasp == nullptr) return;
   const HandGrasp& g = s.grasp->grasp(hand);
-  const bool grasping = !destroyed && g.shown();
+  const bool grasping = !destroyed && g.holdsTarget();
   const uint64_t target = grasping ? g.target : 0;
   XrEventDataGraspChangedSDFG e{XR_TYPE_EVENT_DATA_GRASP_CHANGED_SDFG};
   e.session = s.handle;

@@ -76,7 +76,10 @@ XrResult refuse(const char* cmd, Refusal why, Status engine = Status::ok) {
     case Refusal::none:
       break;
     case Refusal::sessionLost:
-      return logError(XR_ERROR_SESSION_LOST, cmd, "the session is being destroyed");
+      // The handle is going away under the call (a destroy on another thread): the spec's
+      // answer for a handle that is no longer valid. Not SESSION_LOST: the runtime did not lose
+      // the session.
+      return logError(XR_ERROR_HANDLE_INVALID, cmd, "the session is being destroyed");
     case Refusal::notASpace:
       return logError(XR_ERROR_HANDLE_INVALID, cmd,
                       "(placement->space) is not a reference or action space of this session");
@@ -320,22 +323,31 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
   SDFG_VERIFY_CHAIN(cmd, createInfo->next);
   SDFG_VERIFY(cmd,
               countInChain(createInfo->next, XR_TYPE_GRASP_TARGET_VERTICES_SDFG) +
-                      countInChain(createInfo->next, XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG) ==
+                      countInChain(createInfo->next, XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG) +
+                      countInChain(createInfo->next, XR_TYPE_GRASP_TARGET_SHAPE_SDFG) ==
                   1,
               XR_ERROR_VALIDATION_FAILURE,
-              "(createInfo->next) must chain exactly one XrGraspTargetVerticesSDFG or "
-              "XrGraspTargetVulkanBuffersSDFG");
+              "(createInfo->next) must chain exactly one XrGraspTargetVerticesSDFG, "
+              "XrGraspTargetVulkanBuffersSDFG or XrGraspTargetShapeSDFG");
   const auto* arrays = findInChain<const XrGraspTargetVerticesSDFG>(
       createInfo->next, XR_TYPE_GRASP_TARGET_VERTICES_SDFG);
   const auto* buffers = findInChain<const XrGraspTargetVulkanBuffersSDFG>(
       createInfo->next, XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG);
+  const auto* shapeInfo =
+      findInChain<const XrGraspTargetShapeSDFG>(createInfo->next, XR_TYPE_GRASP_TARGET_SHAPE_SDFG);
   const auto* settings = findInChain<const XrGraspTargetSettingsSDFG>(
       createInfo->next, XR_TYPE_GRASP_TARGET_SETTINGS_SDFG);
+  const auto* role = findInChain<const XrGraspTargetRoleInfoSDFG>(createInfo->next,
+                                                                  XR_TYPE_GRASP_TARGET_ROLE_SDFG);
   if (XrResult r = verifyTargetSettings(cmd, settings); r != XR_SUCCESS) return r;
+  if (XrResult r = verifyTargetRole(cmd, role); r != XR_SUCCESS) return r;
   if (XrResult r = verifyPlacement(cmd, &createInfo->placement); r != XR_SUCCESS) return r;
   // The checks and the copy of the app's arrays (up to 2^24 vertices) happen before the lock.
   TriangleMesh mesh;
-  if (buffers != nullptr) {
+  AnalyticShape shape;
+  if (shapeInfo != nullptr) {
+    if (XrResult r = readShape(cmd, shapeInfo, shape); r != XR_SUCCESS) return r;
+  } else if (buffers != nullptr) {
     // Fixed when the session was made: no lock needed.
     SDFG_VERIFY(cmd, s->vulkan, XR_ERROR_GRAPHICS_DEVICE_INVALID,
                 "Vulkan buffers need a session with a Vulkan graphics binding");
@@ -346,10 +358,14 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
   auto t = std::make_shared<TargetState>();
   t->handle = newLayerHandle();
   t->session = s;
-  t->space = createInfo->placement.space;
-  t->pose = createInfo->placement.pose;
-  t->vertexCount = buffers != nullptr ? buffers->vertexCount : arrays->vertexCount;
-  t->indexCount = buffers != nullptr ? buffers->indexCount : arrays->indexCount;
+  t->placed = false;  // placeTarget below, under the lock
+  t->shape = shapeInfo != nullptr;
+  t->vertexCount = buffers != nullptr  ? buffers->vertexCount
+                   : arrays != nullptr ? arrays->vertexCount
+                                       : 0;
+  t->indexCount = buffers != nullptr  ? buffers->indexCount
+                  : arrays != nullptr ? arrays->indexCount
+                                      : 0;
   t->deviceBuffers = buffers != nullptr;
   Refusal refusal = Refusal::none;
   Status status = Status::ok;
@@ -359,6 +375,8 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
       refusal = Refusal::sessionLost;
     } else if (!liveSpace(*s, createInfo->placement.space)) {
       refusal = Refusal::notASpace;
+    } else if (shapeInfo != nullptr) {
+      status = s->grasp->addShapeTarget(t->handle, shape);
     } else if (buffers != nullptr) {
       if (s->gpu == nullptr || !s->grasp->deferredUsable()) refusal = Refusal::noGpu;
       if (refusal == Refusal::none) {
@@ -375,6 +393,8 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
     }
     if (refusal == Refusal::none && status == Status::ok) {
       applyTargetSettings(*s, t->handle, settings);
+      applyTargetRole(*s, t->handle, role);
+      placeTarget(*s, *t, createInfo->placement.space, createInfo->placement.pose);
       s->targets[t->handle] = t;
     }
   }
@@ -399,12 +419,13 @@ XrResult XRAPI_CALL SdfgXrDestroyGraspTargetSDFG(XrGraspTargetSDFG target) {
     if (s->grasp != nullptr) {
       for (Hand hand : {Hand::left, Hand::right}) {
         const HandGrasp& g = s->grasp->grasp(hand);
-        if (g.shown() && g.target == t->handle)
+        if (g.holdsTarget() && g.target == t->handle)
           noteGraspChange(*s, hand, true, t->handle, /*destroyed=*/true);
       }
       s->grasp->removeTarget(t->handle);
       publishShownHands(*s);  // the next locate shows the hand let go
     }
+    unplaceTarget(*s, *t);
     s->targets.erase(t->handle);
     if (t->deviceBuffers) gpu = s->gpu;
   }
@@ -426,6 +447,9 @@ XrResult XRAPI_CALL SdfgXrUpdateGraspTargetVerticesSDFG(XrGraspTargetSDFG target
   const auto* base = static_cast<const XrBaseInStructure*>(vertices);
   SDFG_VERIFY_CHAIN(cmd, base->next);
   const int32_t type = rawEnum(base->type);
+  SDFG_VERIFY(cmd, !t->shape, XR_ERROR_VALIDATION_FAILURE,
+              "(target) is an analytic shape: it has no vertices (destroy and create it again "
+              "to change it)");
   Refusal refusal = Refusal::none;
   Status status = Status::ok;
   if (type == XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG) {
@@ -499,9 +523,7 @@ XrResult XRAPI_CALL SdfgXrSetGraspTargetPlacementSDFG(XrGraspTargetSDFG target,
       refusal = Refusal::notASpace;
     } else {
       // Placed again (also after its space was destroyed): it takes part from the next sync.
-      t->space = placement->space;
-      t->pose = placement->pose;
-      t->placed = true;
+      placeTarget(*s, *t, placement->space, placement->pose);
     }
   }
   return refuse(cmd, refusal);
@@ -529,7 +551,7 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
     return refuse(cmd, Refusal::sessionLost);
   }
   const HandGrasp& g = s->grasp->grasp(hand);
-  const bool held = g.shown();
+  const bool held = g.holdsTarget();
   state->isGrasping = held ? XR_TRUE : XR_FALSE;
   state->target = held ? fromKey<XrGraspTargetSDFG>(g.target) : XR_NULL_HANDLE;
   state->squeeze = s->squeeze[hand == Hand::left ? 0 : 1];
@@ -550,6 +572,8 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
     out.distance = honest ? c.distance : held ? fs.distance : 0.0f;
   }
   writeGraspStateV2(*s, hand, held, state);
+  if (auto* touches = findInChain<XrGraspTouchesSDFG>(state->next, XR_TYPE_GRASP_TOUCHES_SDFG))
+    writeTouches(g, *touches);
   if (auto* info = findInChain<XrGraspBuildInfoSDFG>(state->next, XR_TYPE_GRASP_BUILD_INFO_SDFG)) {
     const SdfBuildStats& st = s->grasp->buildStats();
     info->graspBackend = !held          ? XR_GRASP_SDF_BACKEND_NONE_SDFG

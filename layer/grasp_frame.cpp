@@ -1,9 +1,11 @@
 // The layer's grab update, once per sync of its action set: gather, hand over, publish.
 //
 // 1. Gather, no lock held: the squeeze of each hand (xrGetActionStateFloat), the hand (the
-//    layer's own hand tracker on the runtime, else the grip pose), the pose of every placed target
-//    (xrLocateSpace). The spaces of the targets are marked in use first, so an xrDestroySpace on
-//    another thread waits for these calls instead of the layer passing a destroyed space down.
+//    layer's own hand tracker on the runtime, else the grip pose), and where each space that
+//    holds placed targets is (one xrLocateSpace per space, whatever the number of targets in it:
+//    the engine keeps each target's pose in its space). The spaces are marked in use first, so
+//    an xrDestroySpace on another thread waits for these calls instead of the layer passing a
+//    destroyed space down.
 // 2. Hand over, under the session's lock (microseconds, no call out): the engine's update per
 //    hand, the grasp events, the offsets, and a ShownHand per hand published for
 //    xrLocateHandJointsEXT.
@@ -35,12 +37,6 @@ std::optional<Pose> locate(const InstanceState& inst, XrSpace space, XrSpace bas
   return toPose(loc.pose);
 }
 
-struct PlacedTarget {
-  uint64_t id = 0;
-  XrSpace space = XR_NULL_HANDLE;
-  XrPosef pose{};
-};
-
 // What the gather needs, copied under the lock.
 struct Plan {
   XrTime time = 0;
@@ -49,7 +45,7 @@ struct Plan {
   std::array<XrHandTrackerEXT, 2> trackers{};
   std::array<bool, 2> createTracker{};  // this call asks the runtime for the hand's tracker
   std::array<bool, 2> tracked{};        // the hand may be tracked by the runtime
-  std::vector<PlacedTarget> targets;    // their spaces are marked in use
+  std::vector<XrSpace> spaces;          // spaces holding placed targets, marked in use
 };
 
 // What the runtime said, for the engine.
@@ -62,7 +58,7 @@ struct Gathered {
   std::array<JointRadii, 2> radii{};
   std::array<XrHandTrackerEXT, 2> created{};
   std::array<XrResult, 2> createResult{};
-  std::vector<TargetFrame> targets;
+  std::vector<SpaceFrame> spaces;
 };
 
 std::optional<Plan> planGather(SessionState& s) {
@@ -87,15 +83,10 @@ std::optional<Plan> planGather(SessionState& s) {
       p.createTracker[h] = true;
     }
   }
-  p.targets.reserve(s.targets.size());
-  for (const auto& [id, t] : s.targets) {
-    PlacedTarget pt{id, XR_NULL_HANDLE, t->pose};
-    auto use = t->placed ? s.spaces.find(key(t->space)) : s.spaces.end();
-    if (use != s.spaces.end() && !use->second.dying) {
-      ++use->second.users;
-      pt.space = t->space;
-    }
-    p.targets.push_back(pt);
+  for (auto& [space, use] : s.spaces) {
+    if (use.targets == 0 || use.dying) continue;
+    ++use.users;
+    p.spaces.push_back(fromKey<XrSpace>(space));
   }
   return p;
 }
@@ -150,15 +141,15 @@ Gathered gather(SessionState& s, const Plan& p, const char* cmd) {
     }
     if (!g.trackedValid[h]) g.grip[h] = locate(inst, p.grips[h], p.local, p.time);
   }
-  g.targets.reserve(p.targets.size());
-  for (const PlacedTarget& t : p.targets) {
-    TargetFrame f;
-    f.id = t.id;
-    if (auto located = locate(inst, t.space, p.local, p.time)) {
+  g.spaces.reserve(p.spaces.size());
+  for (XrSpace space : p.spaces) {
+    SpaceFrame f;
+    f.space = key(space);
+    if (auto located = locate(inst, space, p.local, p.time)) {
       f.valid = true;
-      f.worldFromObject = *located * toPose(t.pose);
+      f.worldFromSpace = *located;
     }
-    g.targets.push_back(f);
+    g.spaces.push_back(f);
   }
   return g;
 }
@@ -168,9 +159,8 @@ Gathered gather(SessionState& s, const Plan& p, const char* cmd) {
 // ended. The caller holds the lock.
 bool finishGather(SessionState& s, const Plan& p, const Gathered* g) {
   bool released = false;
-  for (const PlacedTarget& t : p.targets) {
-    if (t.space == XR_NULL_HANDLE) continue;
-    auto use = s.spaces.find(key(t.space));
+  for (XrSpace space : p.spaces) {
+    auto use = s.spaces.find(key(space));
     if (use != s.spaces.end() && --use->second.users == 0) released = true;
   }
   for (size_t h = 0; h < 2; ++h) {
@@ -219,9 +209,9 @@ void updateHands(SessionState& s, const Gathered& g, UpdateReport& report) {
       frame.worldFromWrist = *g.grip[h] * wristFromGrip(s.grasp->model(hand)).inverse();
     }
     const HandGrasp& before = s.grasp->grasp(hand);
-    const bool wasGrasping = before.shown();
+    const bool wasGrasping = before.holdsTarget();
     const uint64_t wasTarget = before.target;
-    report.status[h] = s.grasp->update(hand, frame, g.targets);
+    report.status[h] = s.grasp->update(hand, frame, std::span<const SpaceFrame>(g.spaces));
     noteGraspChange(s, hand, wasGrasping, wasTarget);
     HandOffset& offset = s.offsets.hands[h];
     advanceHandOffset(offset, s.grasp->grasp(hand), s.predictedTime, s.offsets.blendTime);

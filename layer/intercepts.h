@@ -68,6 +68,16 @@ XrResult verifyTargetSettings(const char* cmd, const XrGraspTargetSettingsSDFG* 
 void applyTargetSettings(SessionState& session, uint64_t target,
                          const XrGraspTargetSettingsSDFG* settings);
 
+// target_scene.cpp (version 3, scenes). The caller holds session.mutex for the ones that take a
+// SessionState: a target's placement in a space (the engine's, and the space's count of targets,
+// which the per-frame gather locates), its role, an analytic shape's check, the touches output.
+void placeTarget(SessionState& session, TargetState& target, XrSpace space, const XrPosef& pose);
+void unplaceTarget(SessionState& session, TargetState& target);
+XrResult verifyTargetRole(const char* cmd, const XrGraspTargetRoleInfoSDFG* role);
+void applyTargetRole(SessionState& session, uint64_t target, const XrGraspTargetRoleInfoSDFG* role);
+XrResult readShape(const char* cmd, const XrGraspTargetShapeSDFG* shape, AnalyticShape& out);
+void writeTouches(const HandGrasp& grasp, XrGraspTouchesSDFG& out);
+
 // target_state.cpp (version 3): xrGetGraspTargetStateSDFG.
 XrResult XRAPI_CALL SdfgXrGetGraspTargetStateSDFG(XrGraspTargetSDFG, XrGraspTargetStateSDFG*);
 

@@ -305,8 +305,7 @@ XrResult XRAPI_CALL SdfgXrDestroySpace(XrSpace space) {
     }
     for (const auto& [id, t] : s->targets) {
       if (!t->placed || t->space != space) continue;
-      t->placed = false;
-      t->space = XR_NULL_HANDLE;
+      unplaceTarget(*s, *t);
       unplaced.push_back(id);
     }
     if (s->grasp != nullptr) {
@@ -314,7 +313,7 @@ XrResult XRAPI_CALL SdfgXrDestroySpace(XrSpace space) {
         const HandGrasp& g = s->grasp->grasp(hand);
         if (!g.holding || std::find(unplaced.begin(), unplaced.end(), g.target) == unplaced.end())
           continue;
-        const bool wasGrasping = g.shown();
+        const bool wasGrasping = g.holdsTarget();
         const uint64_t wasTarget = g.target;
         s->grasp->release(hand);
         noteGraspChange(*s, hand, wasGrasping, wasTarget);

@@ -125,6 +125,7 @@ struct TargetState;
 struct SpaceUse {
   int users = 0;       // the layer's calls that pass it down right now (xrLocateSpace)
   bool dying = false;  // xrDestroySpace is under way: no new use may start
+  int targets = 0;     // targets placed in it: located once per frame while there are any
 };
 
 struct SessionState {
@@ -197,6 +198,7 @@ struct TargetState {
   XrSpace space = XR_NULL_HANDLE;
   XrPosef pose{};
   bool placed = true;
+  bool shape = false;  // an analytic shape (version 3): no vertices to update
   uint32_t vertexCount = 0;
   uint32_t indexCount = 0;
   bool deviceBuffers = false;  // the mesh is the app's Vulkan buffers

@@ -1,5 +1,5 @@
 // XR_SDFG_auto_grasp version 2: per-target settings (which hands may grasp a target), on
-// creation and through xrSetGraspTargetSettingsSDFG.
+// creation and through xrSetGraspTargetSettingsSDFG (which also takes a version 3 role).
 #include "intercepts.h"
 #include "log.h"
 #include "state.h"
@@ -40,13 +40,24 @@ XrResult XRAPI_CALL SdfgXrSetGraspTargetSettingsSDFG(XrGraspTargetSDFG target,
     return logError(XR_ERROR_VALIDATION_FAILURE, cmd, "(settings->type) is %d",
                     int(settings->type));
   if (XrResult r = verifyTargetSettings(cmd, settings); r != XR_SUCCESS) return r;
+  // Version 3: a role chained on the settings.
+  if (chainLength(settings->next) < 0)
+    return logError(XR_ERROR_VALIDATION_FAILURE, cmd,
+                    "(settings->next) has more than %zu structs: a cycle, or not a chain",
+                    kMaxChainLength);
+  const auto* role =
+      findInChain<const XrGraspTargetRoleInfoSDFG>(settings->next, XR_TYPE_GRASP_TARGET_ROLE_SDFG);
+  if (XrResult r = verifyTargetRole(cmd, role); r != XR_SUCCESS) return r;
   bool lost = false;
   {
     std::lock_guard lock(s->mutex);
     lost = s->grasp == nullptr;
-    if (!lost) applyTargetSettings(*s, t->handle, settings);
+    if (!lost) {
+      applyTargetSettings(*s, t->handle, settings);
+      applyTargetRole(*s, t->handle, role);
+    }
   }
-  if (lost) return logError(XR_ERROR_SESSION_LOST, cmd, "the session is being destroyed");
+  if (lost) return logError(XR_ERROR_HANDLE_INVALID, cmd, "the session is being destroyed");
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)
 }

@@ -28,7 +28,9 @@
 //   itself, counts as too long: it is refused, never followed forever).
 // - XR_ERROR_POSE_INVALID: a pose whose orientation is not a unit quaternion (|q|^2 within 1e-3
 //   of 1); a finite pose is checked first (non-finite: XR_ERROR_VALIDATION_FAILURE).
-// - XR_ERROR_SESSION_LOST: the session is being destroyed on another thread.
+// - XR_ERROR_HANDLE_INVALID also: a call racing with the destruction of its session (or its
+//   target) on another thread finds the handle gone. (Up to version 2 that was
+//   XR_ERROR_SESSION_LOST, which the spec reserves for a session the runtime lost.)
 // - XR_ERROR_OUT_OF_MEMORY: the layer could not allocate what the call needs.
 // - XR_ERROR_RUNTIME_FAILURE: a failure inside the layer (logged).
 // Function-specific errors are listed at each function type below.
@@ -60,11 +62,19 @@ XR_DEFINE_HANDLE(XrGraspTargetSDFG)
 // Limits, so a stray count cannot exhaust memory.
 #define XR_MAX_GRASP_TARGET_VERTICES_SDFG (1u << 24)
 #define XR_MAX_GRASP_TARGET_INDICES_SDFG (3u << 24)
+// Unused: no function takes a solver name (strategies are XrGraspSolverSDFG values). Kept so that
+// version 1 sources that name it still compile.
 #define XR_MAX_GRASP_SOLVER_NAME_SIZE_SDFG 64
 #define XR_GRASP_FINGER_COUNT_SDFG 5
 
 // Where a target is: `pose` in `space`, located at every frame, so a target in an action space
-// or an anchor follows it. The mesh's vertices are in the target's own frame (metres).
+// follows it. `space` must be a reference space or an action space the app created on the
+// target's session (the layer checks that the handle is one of them, and never passes a space it
+// cannot vouch for to the runtime); other kinds of spaces (spatial anchors of vendor extensions)
+// are refused with XR_ERROR_HANDLE_INVALID: locate an anchor yourself and set the target's pose in
+// a reference space with xrSetGraspTargetPlacementSDFG each frame it moves. Targets in one space
+// cost one xrLocateSpace per frame together, whatever their number. The mesh's vertices are in
+// the target's own frame (metres).
 typedef struct XrGraspTargetPlacementSDFG {
   XrStructureType type;  // XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG
   const void* XR_MAY_ALIAS next;
@@ -155,8 +165,10 @@ typedef struct XrGraspStateGetInfoSDFG {
 typedef struct XrGraspFingerStateSDFG {
   float curl;               // 0 open .. 1 closed: how far the finger is allowed to close
   XrBool32 inContact;       // it stopped on the surface (XR_FALSE: it closes without touching)
-  XrVector3f contactPoint;  // target frame: centre of the touching fingertip sphere
-  float distance;           // signed distance of the target at contactPoint (about the tip radius)
+  XrVector3f contactPoint;  // target frame: centre of the touching sphere (any part of the finger,
+                            // not only its tip; see version 2 below)
+  float distance;           // signed distance of the target at contactPoint (about the radius of
+                            // the finger there)
 } XrGraspFingerStateSDFG;
 
 // Output. Fingers in thumb, index, middle, ring, little order.
@@ -219,7 +231,10 @@ typedef struct XrGraspOptionsSDFG {
   XrStructureType type;  // XR_TYPE_GRASP_OPTIONS_SDFG
   const void* XR_MAY_ALIAS next;
   XrGraspSolverSDFG solver;
-  float tipRadius;      // metres, 0 = each finger's own tip radius; else in (0, 0.05]
+  // The stop distance, metres: a finger stops where the target's distance at its fingertip's
+  // centre falls to this (0 = each finger's own tip radius, so the fingertip's surface touches;
+  // larger stops it that far off). Named for what it defaults to; else in (0, 0.05].
+  float tipRadius;
   XrPosef boxPose;      // grab box centre and axes in the wrist joint's frame (ignored when
                         // boxSize is zero)
   XrVector3f boxSize;   // edge lengths x y z in metres, each in (0, 1]; all zero = default
@@ -235,7 +250,7 @@ typedef struct XrGraspOptionsSDFG {
 // XrGraspTargetVerticesSDFG for the zero-area rule, checked by the set-up); a non-finite
 // placement pose),
 // POSE_INVALID (placement orientation), GRAPHICS_DEVICE_INVALID and FEATURE_UNSUPPORTED (Vulkan
-// buffers, see XrGraspTargetVulkanBuffersSDFG), OUT_OF_MEMORY, SESSION_LOST, RUNTIME_FAILURE.
+// buffers, see XrGraspTargetVulkanBuffersSDFG), OUT_OF_MEMORY, RUNTIME_FAILURE.
 typedef XrResult(XRAPI_PTR* PFN_xrCreateGraspTargetSDFG)(
     XrSession session, const XrGraspTargetCreateInfoSDFG* createInfo, XrGraspTargetSDFG* target);
 // Removes `target`; a hand holding it lets go. Errors: HANDLE_INVALID (null, destroyed, or its
@@ -251,7 +266,7 @@ typedef XrResult(XRAPI_PTR* PFN_xrDestroyGraspTargetSDFG)(XrGraspTargetSDFG targ
 // set on arrays; a non-finite coordinate; any rule of XrGraspTargetVulkanBuffersSDFG broken; a
 // chain too long; positions that give a triangle zero area are dropped later, see
 // XrGraspTargetVerticesSDFG), FEATURE_UNSUPPORTED (a buffer target
-// after the session's GPU path failed), SESSION_LOST, OUT_OF_MEMORY, RUNTIME_FAILURE.
+// after the session's GPU path failed), OUT_OF_MEMORY, RUNTIME_FAILURE.
 typedef XrResult(XRAPI_PTR* PFN_xrUpdateGraspTargetVerticesSDFG)(XrGraspTargetSDFG target,
                                                                  const void* vertices);
 // Moves `target` to another space of its session, or another pose. Errors: HANDLE_INVALID
@@ -262,7 +277,7 @@ typedef XrResult(XRAPI_PTR* PFN_xrSetGraspTargetPlacementSDFG)(
 // Fills `state` (and an XrGraspBuildInfoSDFG chained on it) for one hand. Errors:
 // HANDLE_INVALID (session), VALIDATION_FAILURE (getInfo or state null or of the wrong `type`;
 // hand neither XR_HAND_LEFT_EXT nor XR_HAND_RIGHT_EXT; a chain too long on either),
-// SESSION_LOST, RUNTIME_FAILURE.
+// RUNTIME_FAILURE.
 typedef XrResult(XRAPI_PTR* PFN_xrGetGraspStateSDFG)(XrSession session,
                                                      const XrGraspStateGetInfoSDFG* getInfo,
                                                      XrGraspStateSDFG* state);
@@ -270,7 +285,7 @@ typedef XrResult(XRAPI_PTR* PFN_xrGetGraspStateSDFG)(XrSession session,
 // VALIDATION_FAILURE (options null or of the wrong `type`; solver not one of the listed values;
 // a field outside its range, NaN included; boxPose non-finite or farther than 1 m from the wrist
 // when boxSize is set; a chain too long), POSE_INVALID (boxPose orientation when boxSize is
-// set), FEATURE_UNSUPPORTED (XR_GRASP_SOLVER_OURS_SDFG in a build without it), SESSION_LOST,
+// set), FEATURE_UNSUPPORTED (XR_GRASP_SOLVER_OURS_SDFG in a build without it),
 // OUT_OF_MEMORY, RUNTIME_FAILURE.
 typedef XrResult(XRAPI_PTR* PFN_xrSetGraspOptionsSDFG)(XrSession session,
                                                        const XrGraspOptionsSDFG* options);
@@ -388,11 +403,8 @@ static const XrGraspHandFlagsSDFG XR_GRASP_HAND_RIGHT_BIT_SDFG = 0x00000002;
 // graspable by both hands), or changed with xrSetGraspTargetSettingsSDFG (from the next
 // xrSyncActions; a hand holding the target that may no longer grasp it lets go, with a
 // XR_GRASP_CHANGE_REASON_RELEASED_SDFG event).
-// Which target a grab takes when several are in the hand's grab box: among the targets that hand
-// may grasp whose bounds overlap the grab box (the bounds are the mesh's axis-aligned bounding
-// box in the target frame, or XrGraspTargetVulkanBuffersSDFG's bounds, placed where the target
-// is), the one whose bounds' centre is nearest the grab box's centre; between equally near
-// targets the choice is unspecified. A grasp keeps its target until it ends.
+// A target a hand may not grasp is still there for that hand: its fingers stop on it (version 3;
+// see "Scenes" below for which target a grab takes when several are in the grab box).
 typedef struct XrGraspTargetSettingsSDFG {
   XrStructureType type;  // XR_TYPE_GRASP_TARGET_SETTINGS_SDFG
   const void* XR_MAY_ALIAS next;
@@ -407,10 +419,11 @@ typedef struct XrGraspTargetSettingsSDFG {
 typedef XrResult(XRAPI_PTR* PFN_xrSetGraspTargetSettingsSDFG)(
     XrGraspTargetSDFG target, const XrGraspTargetSettingsSDFG* settings);
 
-// ---- Version 2, continued: never inside (the hand's clearance and offset) ------------------
-// Added after the version 1 structs, which keep their layout: an app built against version 1
-// keeps working and simply does not chain these. Structure types continue in the extension's
-// range at 1009900040.
+// ---- Version 3 (first published in a version 2 header): never inside ------------------------
+// The hand's clearance and offset. These two structs appeared in the header while it still said
+// version 2, without a version change; they belong to version 3: a layer that reports
+// XR_SDFG_auto_grasp_SPEC_VERSION 3 or more honours them. Added after the version 1 structs, which
+// keep their layout. Structure types continue in the extension's range at 1009900040.
 #define XR_TYPE_GRASP_HAND_OFFSET_SDFG ((XrStructureType)1009900040)
 #define XR_TYPE_GRASP_CLEARANCE_OPTIONS_SDFG ((XrStructureType)1009900041)
 
@@ -481,6 +494,104 @@ typedef struct XrGraspTargetStateSDFG {
 // XR_ERROR_RUNTIME_FAILURE; `state` is not written then.
 typedef XrResult(XRAPI_PTR* PFN_xrGetGraspTargetStateSDFG)(XrGraspTargetSDFG target,
                                                            XrGraspTargetStateSDFG* state);
+
+// ---------------------------------------------------------------------------------------------
+// Version 3, scenes: every target in the grab box takes part; roles; analytic shapes; touches.
+//
+// What a grasp sees: every target whose bounds overlap the hand's grab box (the bounds are the
+// mesh's axis-aligned bounding box in the target frame, XrGraspTargetVulkanBuffersSDFG's bounds,
+// or the shape's, placed where the target is; a plane reaches the box when the box reaches below
+// it), except targets whose role is IGNORED. The fingers close on all of them at once: every part
+// of the hand stops on the first surface it meets, whoever owns it, and the hand's clearance
+// (XrGraspHandOffsetSDFG) keeps it out of all of them. The layer finds the targets near a hand
+// through a broad phase over their bounds (a tree per space), so a session may register
+// thousands.
+//
+// Which target a grab takes (the rule, deterministic):
+//   1. among the targets in the grab box that the hand may take (role GRASPABLE and, for that
+//      hand, XrGraspTargetSettingsSDFG::graspableBy) and that the hand touches, the one the most
+//      fingers touch. A finger touches the target that owns the nearest surface at its touching
+//      sphere; the palm touches a target whose surface is within 2 cm of the palm joint's sphere
+//      (a flat object under the palm, a comb on a table, is often touched by no finger: they
+//      close past it onto the table);
+//   2. between those, the one whose surface is nearest the palm joint's centre (exact distance);
+//   3. between those, the one created first.
+// A target the hand does not touch is never taken (one behind another, say). While the fingers touch only targets the hand may
+// not take (a table, a wall, a target of the other hand), the hand holds nothing: its fingers
+// rest on what they touch (xrLocateHandJointsEXT shows them closed there; XrGraspTouchesSDFG
+// says on what), isGrasping stays XR_FALSE, and the first solve whose fingers touch a graspable
+// target takes it. A grasp keeps its target until it ends. Up to version 2 the rule was the
+// target whose bounds' centre was nearest the grab box's centre.
+//
+// Every version 1 and 2 struct keeps its layout, and their apps run unchanged: their targets are
+// GRASPABLE, and a target they made not graspable by a hand (graspableBy) now stops that hand's
+// fingers instead of being passed through. Structure type values of this part:
+// 1009900050..1009900059.
+// ---------------------------------------------------------------------------------------------
+
+#define XR_TYPE_GRASP_TARGET_ROLE_SDFG ((XrStructureType)1009900050)
+#define XR_TYPE_GRASP_TARGET_SHAPE_SDFG ((XrStructureType)1009900051)
+#define XR_TYPE_GRASP_TOUCHES_SDFG ((XrStructureType)1009900052)
+#define XR_TYPE_GRASP_OUTER_HAND_OPTIONS_SDFG ((XrStructureType)1009900053)
+
+// What a target is to the hands.
+typedef enum XrGraspTargetRoleSDFG {
+  XR_GRASP_TARGET_ROLE_GRASPABLE_SDFG = 0,  // hands grasp it and stop on it (the default)
+  XR_GRASP_TARGET_ROLE_SCENE_SDFG = 1,      // hands stop on it and never take it: tables,
+                                            // shelves, walls, a character's body
+  XR_GRASP_TARGET_ROLE_IGNORED_SDFG = 2,    // hands pass through it, as if it were not there
+  XR_GRASP_TARGET_ROLE_MAX_ENUM_SDFG = 0x7FFFFFFF
+} XrGraspTargetRoleSDFG;
+
+// A target's role: chained on XrGraspTargetCreateInfoSDFG::next (without it: GRASPABLE), or on
+// XrGraspTargetSettingsSDFG::next given to xrSetGraspTargetSettingsSDFG (from the next
+// xrSyncActions; a hand holding a target that is no longer GRASPABLE lets go, with a
+// XR_GRASP_CHANGE_REASON_RELEASED_SDFG event). A role outside the listed values:
+// XR_ERROR_VALIDATION_FAILURE, and nothing changes.
+typedef struct XrGraspTargetRoleInfoSDFG {
+  XrStructureType type;  // XR_TYPE_GRASP_TARGET_ROLE_SDFG
+  const void* XR_MAY_ALIAS next;
+  XrGraspTargetRoleSDFG role;
+} XrGraspTargetRoleInfoSDFG;
+
+// Simple solids a target can be instead of a mesh.
+typedef enum XrGraspShapeTypeSDFG {
+  // A box centred on the target frame's origin, edges along its axes (halfExtents).
+  XR_GRASP_SHAPE_TYPE_BOX_SDFG = 1,
+  // The target frame's y = 0 plane, solid below it (its outward normal is +Y): a floor, or a wall
+  // placed with +Y toward the room. halfExtents must be zero.
+  XR_GRASP_SHAPE_TYPE_PLANE_SDFG = 2,
+  XR_GRASP_SHAPE_TYPE_MAX_ENUM_SDFG = 0x7FFFFFFF
+} XrGraspShapeTypeSDFG;
+
+// A target that is an analytic shape: chain it on XrGraspTargetCreateInfoSDFG::next as the
+// target's one mesh struct (instead of XrGraspTargetVerticesSDFG or ...VulkanBuffersSDFG). Its
+// distance is exact and cheap, and it is ready at once (no set-up). Scene geometry is often no
+// more than this; a shape may also be GRASPABLE (a box on a table). It cannot be updated with
+// xrUpdateGraspTargetVerticesSDFG (XR_ERROR_VALIDATION_FAILURE): destroy and create it again to
+// resize it.
+typedef struct XrGraspTargetShapeSDFG {
+  XrStructureType type;  // XR_TYPE_GRASP_TARGET_SHAPE_SDFG
+  const void* XR_MAY_ALIAS next;
+  XrGraspShapeTypeSDFG shapeType;
+  // BOX: half the edge lengths along the target frame's x, y, z, metres, each finite and in
+  // (0, 1000]; PLANE: (0, 0, 0). Anything else: XR_ERROR_VALIDATION_FAILURE.
+  XrVector3f halfExtents;
+} XrGraspTargetShapeSDFG;
+
+// Optional output, chained on XrGraspStateSDFG::next: what the hand's fingers touch, held or not.
+typedef struct XrGraspTouchesSDFG {
+  XrStructureType type;  // XR_TYPE_GRASP_TOUCHES_SDFG
+  void* XR_MAY_ALIAS next;
+  // The hand's fingers rest on solved poses: a grab is on (the squeeze is held and a solve is
+  // shown), whether it holds a target (isGrasping) or only rests on targets it may not take.
+  XrBool32 isClosed;
+  // Per finger (thumb, index, middle, ring, little), the target its contact is on;
+  // XR_NULL_HANDLE where the finger touches nothing (or the hand is not closed). A finger on a
+  // target other than the held one has no contact in XrGraspContactsSDFG (whose points are in
+  // the held target's frame).
+  XrGraspTargetSDFG touched[XR_GRASP_FINGER_COUNT_SDFG];
+} XrGraspTouchesSDFG;
 
 #ifdef __cplusplus
 }

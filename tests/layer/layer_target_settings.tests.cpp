@@ -2,6 +2,9 @@
 // run time, and which of several targets in the grab box a grab takes.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <iterator>
+
 #include "grasp_v2.h"
 
 namespace {
@@ -43,7 +46,7 @@ XrGraspTargetSDFG makeTargetFor(const GraspRun& run, const TestMesh& mesh, const
 
 }  // namespace
 
-TEST_CASE("A target the hand may not grasp is skipped until the app allows it",
+TEST_CASE("A target the hand may not grasp is not taken until the app allows it",
           "[layer][target_settings]") {
   const XrVector3f centre = boxCentreInLocal(kGrip, /*right=*/true);
   const TestMesh sphere = makeIcosphere(0.04f, 3);
@@ -77,23 +80,32 @@ TEST_CASE("A target the hand may not grasp is skipped until the app allows it",
   CHECK(validationLog().empty());
 }
 
-TEST_CASE("Of several targets in the grab box, the grab takes the nearest the box's centre",
+TEST_CASE("A target the hand may not grasp stops its fingers, and is taken once it may",
           "[layer][target_settings]") {
+  // Version 3: two targets in the grab box; the nearer one, under the fingers, is the other
+  // hand's. The right hand's fingers stop on it and never take it; allowed, it is taken.
   const XrVector3f centre = boxCentreInLocal(kGrip, /*right=*/true);
   const TestMesh small = makeIcosphere(0.02f, 3);
-  const bool nearerAllowed = GENERATE(true, false);
-  CAPTURE(nearerAllowed);
-  // The farther one first, so creation order cannot be what decides.
   GraspRun run(small, {{0, 0, 0, 1}, offset(centre, -0.04f)}, kGrip);
-  const XrGraspTargetSDFG farther = run.target;
-  const XrGraspTargetSDFG nearer =
-      makeTargetFor(run, small, {{0, 0, 0, 1}, offset(centre, 0.01f)},
-                    nearerAllowed ? XR_GRASP_HAND_RIGHT_BIT_SDFG : XR_GRASP_HAND_LEFT_BIT_SDFG);
-  // A grab picks among the targets ready at its frame: both must be set up before the squeeze.
+  const XrPosef under = belowOpenRightPalm(small, kGrip, {0, 0, 0, 1});
+  const XrGraspTargetSDFG leftOnly = makeTargetFor(run, small, under, XR_GRASP_HAND_LEFT_BIT_SDFG);
   REQUIRE(untilSetUp(*run.app, *run.ext, [](const auto& setup) { return setup.readyCount >= 2; }));
-  REQUIRE(runUntil(*run.app, [&] { return run.grasping(); }));
-  // The nearest the hand may grasp.
-  CHECK(heldTarget(run) == (nearerAllowed ? nearer : farther));
+  XrGraspTouchesSDFG touches{XR_TYPE_GRASP_TOUCHES_SDFG};
+  XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG, &touches};
+  REQUIRE(runUntil(*run.app, [&] {
+    return run.state(st) == XR_SUCCESS && touches.isClosed == XR_TRUE &&
+           std::count(std::begin(touches.touched), std::end(touches.touched), leftOnly) > 0;
+  }));
+  CHECK(heldTarget(run) != leftOnly);
+  auto setSettings = run.app->fn<PFN_xrSetGraspTargetSettingsSDFG>("xrSetGraspTargetSettingsSDFG");
+  XrGraspTargetSettingsSDFG both{XR_TYPE_GRASP_TARGET_SETTINGS_SDFG, nullptr,
+                                 XR_GRASP_HAND_LEFT_BIT_SDFG | XR_GRASP_HAND_RIGHT_BIT_SDFG};
+  // Unless the hand already took the other one, it takes this one once allowed (the fingers on
+  // it, the squeeze held).
+  if (heldTarget(run) == XR_NULL_HANDLE) {
+    REQUIRE(setSettings(leftOnly, &both) == XR_SUCCESS);
+    REQUIRE(runUntil(*run.app, [&] { return heldTarget(run) == leftOnly; }));
+  }
   CHECK(validationLog().empty());
 }
 

@@ -260,7 +260,8 @@ TEST_CASE("A grasp takes the graspable target most fingers touch, then the palm'
     touch(2, glm::vec3(-0.04f, -0.02f - rad, 0.0f));
     touch(3, glm::vec3(0.03f, -0.02f - rad, 0.0f));  // under b
     touch(4, glm::vec3(0.02f, -0.02f - rad, 0.0f));
-    const GraspChoice c = chooseTarget(members, source, r, glm::vec3(0.0f, -0.1f, 0.0f), 0.01f);
+    const GraspChoice c =
+        chooseTarget(members, source, r, glm::vec3(0.0f, -0.1f, 0.0f), 0.01f, 0.01f);
     CHECK(c.member == 0);
     CHECK(c.fingersOnChoice == 3);
     CHECK(c.touched[3] == 1);
@@ -268,16 +269,30 @@ TEST_CASE("A grasp takes the graspable target most fingers touch, then the palm'
   SECTION("a tie goes to the target nearer the palm") {
     touch(1, glm::vec3(-0.03f, -0.02f - rad, 0.0f));  // a
     touch(2, glm::vec3(0.03f, -0.02f - rad, 0.0f));   // b
-    CHECK(chooseTarget(members, source, r, glm::vec3(0.02f, -0.05f, 0.0f), 0.01f).member == 1);
-    CHECK(chooseTarget(members, source, r, glm::vec3(-0.02f, -0.05f, 0.0f), 0.01f).member == 0);
+    CHECK(chooseTarget(members, source, r, glm::vec3(0.02f, -0.05f, 0.0f), 0.01f, 0.01f).member ==
+          1);
+    CHECK(chooseTarget(members, source, r, glm::vec3(-0.02f, -0.05f, 0.0f), 0.01f, 0.01f).member ==
+          0);
+  }
+  SECTION("a target under the palm that no finger touches is taken; one farther is not") {
+    touch(1, glm::vec3(0.2f, -0.19f + rad, 0.0f));  // fingers on the table, past block a
+    touch(2, glm::vec3(0.21f, -0.19f + rad, 0.0f));
+    // The palm's surface (radius 1 cm) 5 mm from block a's bottom face (y = -0.02).
+    CHECK(chooseTarget(members, source, r, glm::vec3(-0.03f, -0.035f, 0.0f), 0.01f, 0.01f).member ==
+          0);
+    // 3 cm from it: beyond the palm's touch.
+    CHECK(chooseTarget(members, source, r, glm::vec3(-0.03f, -0.06f, 0.0f), 0.01f, 0.01f).member ==
+          -1);
   }
   SECTION("fingers on the table alone hold nothing; a non-graspable target is never taken") {
     touch(1, glm::vec3(0.2f, -0.19f + rad, 0.0f));  // resting on the table's top
-    const GraspChoice c = chooseTarget(members, source, r, glm::vec3(0.0f), 0.01f);
+    const GraspChoice c =
+        chooseTarget(members, source, r, glm::vec3(0.2f, -0.1f, 0.0f), 0.01f, 0.01f);
     CHECK(c.member == -1);
     members[0].graspable = false;
     r = GraspResult{};
     touch(1, glm::vec3(-0.03f, -0.02f - rad, 0.0f));
-    CHECK(chooseTarget(members, source, r, glm::vec3(0.0f), 0.01f).member == -1);
+    CHECK(chooseTarget(members, source, r, glm::vec3(0.2f, -0.1f, 0.0f), 0.01f, 0.01f).member ==
+          -1);
   }
 }

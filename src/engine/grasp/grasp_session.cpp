@@ -23,6 +23,13 @@ float angleBetween(const glm::quat& a, const glm::quat& b) {
   return 2.0f * std::acos(d);
 }
 
+// The space of a target located on its own (update() with TargetFrames): keys the layer's
+// XrSpace values never take (their top bit is clear: non-canonical x86-64 addresses apart,
+// handles are small integers or user-space pointers).
+uint64_t ownSpace(uint64_t target) {
+  return target | (uint64_t(1) << 63);
+}
+
 }  // namespace
 
 std::optional<Error> GraspSettings::validate() const {
@@ -117,6 +124,7 @@ void GraspSession::refreshSetups() {
       if (t.deviceCopy != nullptr && info.orientedIndices != nullptr)
         t.deviceCopy->indices = *info.orientedIndices;
       setupOrientations_.emplace_back(id, info.orientation);
+      reindex(id, t);
     } else if (info.setup == TargetSetup::failed) {
       t.setup = TargetSetup::failed;
       setupFailures_.emplace_back(id, std::move(info.error));
@@ -141,8 +149,81 @@ Status GraspSession::addDeviceTarget(uint64_t id, const Aabb& bounds) {
   if (!deferredUsable() || !deferred_->hasDeviceMesh(id)) return Status::unsupported;
   Target t;
   t.bounds = bounds;
-  targets_.emplace(id, std::move(t));
+  auto [it, inserted] = targets_.emplace(id, std::move(t));
+  (void)inserted;
+  reindex(id, it->second);
   return Status::ok;
+}
+
+Status GraspSession::addShapeTarget(uint64_t id, const AnalyticShape& shape) {
+  if (targets_.count(id) != 0 || shape.validate()) return Status::invalid_argument;
+  Target t;
+  t.shapeTarget = true;
+  t.shape = shape;
+  t.bounds = shape.bounds();
+  worker_->addShape(id, shape);
+  auto [it, inserted] = targets_.emplace(id, std::move(t));
+  (void)inserted;
+  reindex(id, it->second);
+  return Status::ok;
+}
+
+Status GraspSession::setTargetRole(uint64_t id, TargetRole role) {
+  auto it = targets_.find(id);
+  if (it == targets_.end()) return Status::invalid_argument;
+  it->second.role = role;
+  reindex(id, it->second);
+  return Status::ok;
+}
+
+TargetRole GraspSession::targetRole(uint64_t id) const {
+  auto it = targets_.find(id);
+  return it == targets_.end() ? TargetRole::ignored : it->second.role;
+}
+
+Status GraspSession::placeTarget(uint64_t id, uint64_t space, const Pose& spaceFromObject) {
+  auto it = targets_.find(id);
+  if (it == targets_.end()) return Status::invalid_argument;
+  Target& t = it->second;
+  t.placed = true;
+  t.space = space;
+  t.spaceFromObject = spaceFromObject;
+  t.indexed = false;  // placed anew below
+  index_.remove(id);
+  reindex(id, t);
+  return Status::ok;
+}
+
+Status GraspSession::unplaceTarget(uint64_t id) {
+  auto it = targets_.find(id);
+  if (it == targets_.end()) return Status::invalid_argument;
+  it->second.placed = false;
+  reindex(id, it->second);
+  return Status::ok;
+}
+
+std::vector<SceneHit> GraspSession::targetsNear(const Pose& worldFromBox,
+                                                const glm::vec3& half) const {
+  std::vector<SceneHit> out;
+  index_.query(worldFromBox, half, out);
+  return out;
+}
+
+void GraspSession::reindex(uint64_t id, Target& t) {
+  const bool wanted = t.placed && t.setup == TargetSetup::ready && t.role != TargetRole::ignored;
+  if (!wanted) {
+    if (t.indexed) index_.remove(id);
+    t.indexed = false;
+    return;
+  }
+  std::optional<Aabb> bounds;
+  if (!t.shapeTarget || t.shape->bounded()) bounds = t.bounds;
+  if (!t.indexed || !index_.contains(id)) {
+    index_.place(id, t.space, t.spaceFromObject, bounds);
+  } else if (bounds) {
+    index_.setBounds(id, *bounds);
+  }
+  t.indexed = true;
 }
 
 Status GraspSession::updateTargetBounds(uint64_t id, const Aabb& bounds) {
@@ -150,6 +231,7 @@ Status GraspSession::updateTargetBounds(uint64_t id, const Aabb& bounds) {
   if (it == targets_.end() || it->second.meshTarget) return Status::invalid_argument;
   if (!validBounds(bounds)) return Status::invalid_argument;
   it->second.bounds = bounds;
+  reindex(id, it->second);
   return Status::ok;
 }
 
@@ -197,6 +279,7 @@ Status GraspSession::updateTargetVertices(uint64_t id, std::span<const glm::vec3
   }
   t.bounds = computeBounds(positions);
   ++t.version;
+  reindex(id, t);
   worker_->updateVertices(id, std::vector<glm::vec3>(positions.begin(), positions.end()),
                           t.version);
   return Status::ok;
@@ -212,6 +295,7 @@ Status GraspSession::updateTargetVertices(uint64_t id, std::vector<glm::vec3>&& 
     std::copy(positions.begin(), positions.end(), t.deviceCopy->positions.begin());
   t.bounds = bounds;
   ++t.version;
+  reindex(id, t);
   worker_->updateVertices(id, std::move(positions), t.version);
   return Status::ok;
 }
@@ -222,12 +306,19 @@ std::vector<glm::vec3> GraspSession::vertexBuffer(uint64_t id) {
 
 bool GraspSession::removeTarget(uint64_t id) {
   for (size_t h = 0; h < 2; ++h) {
-    if (hands_[h].grasp.holding && hands_[h].grasp.target == id) {
-      cancelPending(hands_[h], h);
-      hands_[h].grasp = HandGrasp{};
+    HandState& hand = hands_[h];
+    // The hand lets go of a target it holds, and of a grab not yet decided that saw it (a squeeze
+    // still held starts a new grab on what is left).
+    const bool inScene =
+        std::any_of(hand.members.begin(), hand.members.end(),
+                    [&](const GraspWorker::JobMember& m) { return m.target == id; });
+    if (hand.grasp.holding && (hand.grasp.target == id || (!hand.decided && inScene))) {
+      cancelPending(hand, h);
+      hand.grasp = HandGrasp{};
     }
   }
   worker_->removeTarget(id);
+  index_.remove(id);
   return targets_.erase(id) != 0;
 }
 
@@ -250,34 +341,74 @@ Status GraspSession::setTargetHands(uint64_t id, bool left, bool right) {
   return Status::ok;
 }
 
-std::optional<uint64_t> GraspSession::pickTarget(Hand side, const Pose& worldFromWrist,
-                                                 std::span<const TargetFrame> targets) const {
+std::vector<GraspWorker::JobMember> GraspSession::sceneInBox(Hand side, const Pose& worldFromWrist,
+                                                             uint64_t held) const {
   const GridBox& box = settings_.box;
-  const Pose boxFromWorld = (worldFromWrist * box.handFromBox).inverse();
-  const glm::vec3 half = box.size * 0.5f;
-  std::optional<uint64_t> best;
-  float bestDistance = std::numeric_limits<float>::infinity();
-  for (const TargetFrame& t : targets) {
-    auto it = targets_.find(t.id);
-    if (!t.valid || it == targets_.end() || it->second.setup != TargetSetup::ready ||
-        !it->second.hands[size_t(side)])
-      continue;
-    const Pose boxFromObject = boxFromWorld * t.worldFromObject;
-    // The target's bounds, as a box-space AABB of its 8 corners, must overlap the grab box.
-    glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
-    for (int c = 0; c < 8; ++c) {
-      const glm::vec3 corner((c & 1) ? it->second.bounds.max.x : it->second.bounds.min.x,
-                             (c & 2) ? it->second.bounds.max.y : it->second.bounds.min.y,
-                             (c & 4) ? it->second.bounds.max.z : it->second.bounds.min.z);
-      const glm::vec3 p = boxFromObject.transformPoint(corner);
-      lo = glm::min(lo, p);
-      hi = glm::max(hi, p);
-    }
-    if (glm::any(glm::greaterThan(lo, half)) || glm::any(glm::lessThan(hi, -half))) continue;
-    const float d = glm::length(boxFromObject.transformPoint(it->second.bounds.center()));
-    if (d < bestDistance) bestDistance = d, best = t.id;
+  const Pose worldFromBox = worldFromWrist * box.handFromBox;
+  std::vector<SceneHit> hits;
+  index_.query(worldFromBox, box.size * 0.5f, hits);
+  // The held target takes part wherever it is (the app may not carry it).
+  if (held != 0 &&
+      std::none_of(hits.begin(), hits.end(), [&](const SceneHit& h) { return h.target == held; })) {
+    if (auto at = index_.worldFromObject(held)) hits.push_back(SceneHit{held, *at});
   }
-  return best;
+  const Pose wristFromWorld = worldFromWrist.inverse();
+  struct Candidate {
+    GraspWorker::JobMember member;
+    int rank = 0;  // held first, then device targets (a deferred build takes members[0])
+    float distance = 0.0f;
+  };
+  std::vector<Candidate> found;
+  for (const SceneHit& h : hits) {
+    auto it = targets_.find(h.target);
+    if (it == targets_.end() || it->second.setup != TargetSetup::ready ||
+        it->second.role == TargetRole::ignored)
+      continue;
+    const Target& t = it->second;
+    Candidate c;
+    c.member.target = h.target;
+    c.member.objectFromHand = h.worldFromObject.inverse() * worldFromWrist;
+    c.member.graspable = t.role == TargetRole::graspable && t.hands[size_t(side)];
+    c.rank = h.target == held ? 0 : (!t.meshTarget && !t.shapeTarget ? 1 : 2);
+    const glm::vec3 centre =
+        t.shapeTarget && !t.shape->bounded()
+            ? glm::vec3(0.0f)
+            : (wristFromWorld * h.worldFromObject).transformPoint(t.bounds.center());
+    c.distance = glm::length(box.handFromBox.inverse().transformPoint(centre));
+    found.push_back(c);
+  }
+  // Deterministic: held, device, then by target id (the index answers in id order); the nearest
+  // kept when there are too many.
+  std::stable_sort(found.begin(), found.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.rank < b.rank; });
+  if (found.size() > kMaxSceneMembers) {
+    std::stable_sort(found.begin() + 1, found.end(), [](const Candidate& a, const Candidate& b) {
+      return a.distance < b.distance;
+    });
+    found.resize(kMaxSceneMembers);
+  }
+  std::vector<GraspWorker::JobMember> out;
+  out.reserve(found.size());
+  for (const Candidate& c : found) out.push_back(c.member);
+  return out;
+}
+
+bool GraspSession::sceneChanged(const HandState& hand,
+                                std::span<const GraspWorker::JobMember> now) const {
+  if (now.size() != hand.members.size()) return true;
+  for (size_t i = 0; i < now.size(); ++i) {
+    const GraspWorker::JobMember& a = now[i];
+    const GraspWorker::JobMember& b = hand.members[i];
+    if (a.target != b.target || a.graspable != b.graspable) return true;
+    auto it = targets_.find(a.target);
+    if (it == targets_.end() || it->second.version != hand.memberVersions[i]) return true;
+    if (glm::length(a.objectFromHand.position - b.objectFromHand.position) >
+            settings_.moveTolerance ||
+        angleBetween(a.objectFromHand.orientation, b.objectFromHand.orientation) >
+            settings_.turnTolerance)
+      return true;
+  }
+  return false;
 }
 
 Status GraspSession::prepareSolver(HandState& hand) {
@@ -295,15 +426,15 @@ Status GraspSession::prepareSolver(HandState& hand) {
   return Status::ok;
 }
 
-void GraspSession::post(HandState& hand, size_t slot, uint64_t id, const Pose& objectFromHand,
+void GraspSession::post(HandState& hand, size_t slot, std::vector<GraspWorker::JobMember> members,
                         std::optional<SdfGrid> field, bool gpu, int64_t time) {
   GraspWorker::Job job;
   job.time = time;
   job.extraParts = hand.trackedParts;
   job.extraPartCount = hand.trackedPartCount;
   job.ticket = ++hand.ticket;
-  job.target = id;
-  job.objectFromHand = objectFromHand;
+  job.members = std::move(members);
+  job.held = hand.decided ? hand.grasp.target : 0;
   job.box = settings_.box;
   job.solver = hand.workerSolver;
   job.exactCheck = settings_.exactCheck;
@@ -328,8 +459,15 @@ Status GraspSession::collectJob(HandState& hand, size_t slot) {
     giveUp(hand, slot);
     return done->status;
   }
+  // The first solve that takes a target decides; later ones keep it. A hand that holds nothing
+  // (its fingers on scene geometry) takes a graspable target as soon as they touch one.
+  if (!hand.decided) {
+    hand.grasp.target = done->chosen;
+    hand.decided = done->chosen != 0;
+  }
   hand.grasp.result = done->result;
   hand.grasp.contacts = done->contacts;
+  hand.grasp.touched = done->touched;
   hand.grasp.time = done->time;
   hand.grasp.objectFromHand = done->objectFromHand;
   hand.grasp.builtOnGpu = hand.jobOnGpu;
@@ -338,25 +476,37 @@ Status GraspSession::collectJob(HandState& hand, size_t slot) {
   return Status::ok;
 }
 
-Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Target& target,
-                           const Pose& objectFromHand) {
+Status GraspSession::solve(HandState& hand, size_t slot,
+                           std::vector<GraspWorker::JobMember> members) {
   if (Status s = prepareSolver(hand); s != Status::ok) return s;
-  const bool onDevice = deferredUsable() && (!target.meshTarget || deferredForMeshTargets_);
+  hand.memberVersions.clear();
+  for (const GraspWorker::JobMember& m : members)
+    hand.memberVersions.push_back(targets_.at(m.target).version);
+  hand.members = members;
+  const uint64_t id = members[0].target;
+  const Target& first = targets_.at(id);
+  const bool device = !first.meshTarget && !first.shapeTarget;
+  // The deferred (GPU) backend builds one mesh: a device target (first in the scene when there is
+  // one; the worker merges the rest on the CPU), or a mesh target alone when meshes go there too.
+  const bool onDevice =
+      deferredUsable() &&
+      (device || (first.meshTarget && deferredForMeshTargets_ && members.size() == 1));
   if (onDevice && !deferredReady()) {
     // Still preparing (pipelines made at session start): a device target waits for it, asked
     // again at the next update; a target with a CPU mesh is built on the CPU below rather than
     // keep the hand waiting. A preparation that failed leaves the CPU only.
-    if (!target.meshTarget && deferredUsable()) return Status::ok;
+    if (device && deferredUsable()) return Status::ok;
   } else if (onDevice) {
-    const TriangleMesh* mesh = target.deviceCopy.get();
+    const TriangleMesh* mesh = first.deviceCopy.get();
     const Status s =
-        deferred_->request(slot, id, target.version, mesh, objectFromHand, settings_.box);
+        deferred_->request(slot, id, first.version, mesh, members[0].objectFromHand, settings_.box);
     if (s == Status::ok) {
       hand.pending = true;
       hand.pendingSince = std::chrono::steady_clock::now();
-      hand.pendingPose = objectFromHand;
-      hand.pendingVersion = target.version;
+      hand.pendingPose = members[0].objectFromHand;
+      hand.pendingVersion = first.version;
       hand.pendingTime = hand.frameTime;
+      hand.pendingMembers = std::move(members);
       return Status::ok;
     }
     // Busy with a cancelled build still on the device: ask again at the next update.
@@ -364,8 +514,13 @@ Status GraspSession::solve(HandState& hand, size_t slot, uint64_t id, const Targ
     if (s == Status::invalid_argument) return s;
     stats_.gpuFailed = true;  // the device failed: this and every later build on the CPU
   }
-  if (!target.meshTarget) return Status::device_lost;
-  post(hand, slot, id, objectFromHand, std::nullopt, false, hand.frameTime);
+  // On the CPU, device targets (no CPU mesh) cannot take part.
+  std::erase_if(members, [&](const GraspWorker::JobMember& m) {
+    const Target& t = targets_.at(m.target);
+    return !t.meshTarget && !t.shapeTarget;
+  });
+  if (members.empty()) return Status::device_lost;
+  post(hand, slot, std::move(members), std::nullopt, false, hand.frameTime);
   return Status::ok;
 }
 
@@ -388,26 +543,49 @@ Status GraspSession::collect(HandState& hand, size_t slot) {
   const BuildPoll p = deferred_->poll(slot, hand.grid);
   if (p == BuildPoll::pending) return Status::ok;
   hand.pending = false;
-  auto it = hand.grasp.holding ? targets_.find(hand.grasp.target) : targets_.end();
-  if (it == targets_.end()) return Status::ok;
+  std::vector<GraspWorker::JobMember> members = std::move(hand.pendingMembers);
+  hand.pendingMembers.clear();
+  // Members gone meanwhile do not take part.
+  std::erase_if(members,
+                [&](const GraspWorker::JobMember& m) { return !targets_.count(m.target); });
+  if (!hand.grasp.holding || members.empty() || members[0].target != hand.members[0].target)
+    return Status::ok;
   if (p == BuildPoll::ready) {
     // The solve, with its exact check, is the worker's too; the build counts once its grasp is
     // taken (collectJob), so the count says the grasp shown has it.
-    post(hand, slot, it->first, hand.pendingPose, hand.grid, true, hand.pendingTime);
+    post(hand, slot, std::move(members), hand.grid, true, hand.pendingTime);
     return Status::ok;
   }
   // The device failed (or lost the request): the worker redoes the build on the CPU now.
   if (p == BuildPoll::failed) stats_.gpuFailed = true;
-  if (!it->second.meshTarget) {
+  std::erase_if(members, [&](const GraspWorker::JobMember& m) {
+    const Target& t = targets_.at(m.target);
+    return !t.meshTarget && !t.shapeTarget;
+  });
+  if (members.empty()) {
     hand.grasp = HandGrasp{};
     return Status::device_lost;
   }
-  post(hand, slot, it->first, hand.pendingPose, std::nullopt, false, hand.pendingTime);
+  post(hand, slot, std::move(members), std::nullopt, false, hand.pendingTime);
   return Status::ok;
 }
 
 Status GraspSession::update(Hand side, const HandFrame& frame,
                             std::span<const TargetFrame> targets) {
+  std::vector<SpaceFrame> spaces;
+  spaces.reserve(targets.size());
+  for (const TargetFrame& t : targets) {
+    auto it = targets_.find(t.id);
+    if (it == targets_.end()) continue;
+    if (!it->second.placed || it->second.space != ownSpace(t.id))
+      placeTarget(t.id, ownSpace(t.id), Pose{});
+    spaces.push_back(SpaceFrame{ownSpace(t.id), t.valid, t.worldFromObject});
+  }
+  return update(side, frame, std::span<const SpaceFrame>(spaces));
+}
+
+Status GraspSession::update(Hand side, const HandFrame& frame, std::span<const SpaceFrame> spaces) {
+  index_.setSpaces(spaces);
   const size_t slot = size_t(side);
   HandState& hand = hands_[slot];
   hand.squeeze = std::isfinite(frame.squeeze) ? frame.squeeze : 0.0f;
@@ -427,43 +605,36 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
     return Status::timed_out;
   }
   if (hand.grasp.holding) {
-    auto it = targets_.find(hand.grasp.target);
-    if (it == targets_.end() || !it->second.hands[slot] ||
-        hand.squeeze < settings_.grabThreshold * settings_.releaseRatio) {
+    const uint64_t held = hand.grasp.target;
+    bool keep = hand.squeeze >= settings_.grabThreshold * settings_.releaseRatio;
+    if (held != 0) {
+      auto it = targets_.find(held);
+      keep = keep && it != targets_.end() && it->second.hands[slot] &&
+             it->second.role == TargetRole::graspable;
+    }
+    if (!keep) {
       cancelPending(hand, slot);
       hand.grasp = HandGrasp{};
       return collected;
     }
-    const TargetFrame* located = nullptr;
-    for (const TargetFrame& t : targets) {
-      if (t.id == hand.grasp.target && t.valid) located = &t;
+    if (!frame.valid) return collected;  // keep the last solve
+    std::vector<GraspWorker::JobMember> members = sceneInBox(side, frame.worldFromWrist, held);
+    if (held != 0) {
+      if (members.empty() || members[0].target != held) return collected;  // not located
+      hand.objectFromHandNow = members[0].objectFromHand;
     }
-    if (!frame.valid || located == nullptr) return collected;  // keep the last solve
-    const Pose objectFromHand = located->worldFromObject.inverse() * frame.worldFromWrist;
-    hand.objectFromHandNow = objectFromHand;
     // The build in flight first, then re-check.
-    if (hand.pending || hand.jobPending) return collected;
-    const bool moved =
-        glm::length(objectFromHand.position - hand.grasp.objectFromHand.position) >
-            settings_.moveTolerance ||
-        angleBetween(objectFromHand.orientation, hand.grasp.objectFromHand.orientation) >
-            settings_.turnTolerance;
-    if (hand.grasp.solves > 0 && !moved && hand.solvedVersion == it->second.version)
-      return collected;
+    if (members.empty() || hand.pending || hand.jobPending) return collected;
+    if (hand.grasp.solves > 0 && !sceneChanged(hand, members)) return collected;
     noteTrackedParts(hand, frame);
-    const Status s = solve(hand, slot, it->first, it->second, objectFromHand);
+    const Status s = solve(hand, slot, std::move(members));
     if (s != Status::ok) giveUp(hand, slot);
     return s;
   }
 
   if (!frame.valid || hand.squeeze < settings_.grabThreshold) return collected;
-  const std::optional<uint64_t> id = pickTarget(side, frame.worldFromWrist, targets);
-  if (!id) return collected;
-  const Target& target = targets_.at(*id);
-  const TargetFrame* located = nullptr;
-  for (const TargetFrame& t : targets) {
-    if (t.id == *id) located = &t;
-  }
+  std::vector<GraspWorker::JobMember> members = sceneInBox(side, frame.worldFromWrist, 0);
+  if (members.empty()) return collected;
   // A tracked hand brings its own bone lengths: fit the model to it at the start of the grab.
   if (frame.trackedJoints != nullptr && frame.trackedRadii != nullptr) {
     auto fitted = HandModel::fitToJoints(side, *frame.trackedJoints, *frame.trackedRadii);
@@ -474,11 +645,10 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   }
   hand.grasp = HandGrasp{};
   hand.grasp.holding = true;
-  hand.grasp.target = *id;
+  hand.decided = false;
+  hand.objectFromHandNow.reset();
   noteTrackedParts(hand, frame);
-  const Pose objectFromHand = located->worldFromObject.inverse() * frame.worldFromWrist;
-  hand.objectFromHandNow = objectFromHand;
-  const Status s = solve(hand, slot, *id, target, objectFromHand);
+  const Status s = solve(hand, slot, std::move(members));
   if (s != Status::ok) giveUp(hand, slot);
   return s;
 }

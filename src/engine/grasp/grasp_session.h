@@ -1,11 +1,22 @@
-// Grasping for one XR session: the graspable targets, and per hand a grab state machine that
-// builds the grab-box SDF of the target in the hand and solves the finger curls.
+// Grasping for one XR session: its targets (the scene), and per hand a grab state machine that
+// builds the grab-box SDF of everything in the hand's grab box and solves the finger curls.
 //
-// The layer feeds it one HandFrame per hand per frame (after the app syncs its actions) and
-// reads back each hand's HandGrasp when the app locates joints. States per hand: open -> held
-// when the squeeze reaches the grab threshold with a target in the grab box; held -> open when
-// the squeeze drops below threshold * releaseRatio or the target goes away. While held, the grasp
-// is solved again when the target moves relative to the hand or its vertices change.
+// Targets are meshes (CPU arrays or device buffers) or analytic shapes (scene/analytic_shape.h),
+// each with a role (scene/scene.h: graspable, scene geometry only, ignored) and a placement (a
+// space key and a pose in it). A broad phase over their bounds (scene/scene_index.h) finds the
+// ones in a grab box without a loop over all of them.
+//
+// The layer feeds it the frame's space poses and one HandFrame per hand per frame (after the app
+// syncs its actions) and reads back each hand's HandGrasp when the app locates joints. States
+// per hand: open -> closed when the squeeze reaches the grab threshold with any target in the
+// grab box. The fingers close on the union of every target there (each hand part stops on the
+// first surface it meets, whoever owns it), and each solve takes the graspable target most
+// fingers touch (grasp/target_choice.h), which the hand then keeps until the release; while the
+// fingers touch only scene geometry the hand holds nothing (they still rest on it), and takes a
+// graspable target at the first solve that touches one. closed -> open
+// when the squeeze drops below threshold * releaseRatio or the held target goes away. While
+// closed, the grasp is solved again when anything in the box moves relative to the hand, comes or
+// goes, or changes its vertices.
 //
 // Threading: a GraspWorker owned by the session runs the target set-up (addTarget returns at
 // once; the target is graspable once targetSetup() says ready), the refit after new vertices, the
@@ -46,6 +57,9 @@
 #include "hand/hand_model.h"
 #include "mesh/mesh.h"
 #include "mesh/mesh_distance.h"
+#include "scene/analytic_shape.h"
+#include "scene/scene.h"
+#include "scene/scene_index.h"
 #include "sdf/sdf_backend.h"
 #include "sdf/sdf_grid.h"
 
@@ -87,6 +101,8 @@ struct HandFrame {
   int64_t time = 0;
 };
 
+// A target located in its own right this frame (the older form of update(): each target is
+// its own space). The layer places targets in spaces and passes SpaceFrames instead.
 struct TargetFrame {
   uint64_t id = 0;
   bool valid = false;  // located this frame
@@ -94,12 +110,16 @@ struct TargetFrame {
 };
 
 struct HandGrasp {
-  // The grasp the hand shows: holding, with a first solve in. (Holding alone is the time between
+  // The grasp the hand shows: closed, with a first solve in. (Closed alone is the time between
   // the squeeze and that solve, when the hand still shows the user's own pose.)
   bool shown() const { return holding && solves > 0; }
+  // The hand shows a grasp that holds a target (not only fingers resting on scene geometry).
+  bool holdsTarget() const { return shown() && target != 0; }
 
-  bool holding = false;
-  uint64_t target = 0;
+  bool holding = false;  // closed: the squeeze started a grab that has not ended
+  uint64_t target = 0;   // the target held; 0: none (yet, or the fingers touch no graspable one)
+  // Per finger (thumb first), the target its contact is on at the last solve (0: none).
+  std::array<uint64_t, kFingerCount> touched{};
   GraspResult result{};     // contact points in hand space
   Pose objectFromHand;      // at the last solve
   uint64_t solves = 0;      // how many times this grab was solved
@@ -164,10 +184,26 @@ class GraspSession {
   Status updateTargetBounds(uint64_t id, const Aabb& bounds);
   // New positions, same count; a hand holding the target re-solves at its next update.
   Status updateTargetVertices(uint64_t id, std::span<const glm::vec3> positions);
-  // Which hands may grasp the target (both by default; neither: not graspable for now). A hand
-  // holding it that may no longer lets go at its next update. Errors: invalid_argument (unknown
-  // id).
+  // Which hands may grasp the target (both by default; neither: not graspable for now). For a
+  // hand that may not grasp it, it is scene geometry (the fingers stop on it). A hand holding it
+  // that may no longer lets go at its next update. Errors: invalid_argument (unknown id).
   Status setTargetHands(uint64_t id, bool left, bool right);
+  // A target that is an analytic shape (a table top, a floor): ready at once. Errors:
+  // invalid_argument (id in use, or the shape's validate() refuses it).
+  Status addShapeTarget(uint64_t id, const AnalyticShape& shape);
+  // What the target is to the hands (graspable by default). A hand holding a target that is no
+  // longer graspable lets go at its next update. Errors: invalid_argument (unknown id).
+  Status setTargetRole(uint64_t id, TargetRole role);
+  TargetRole targetRole(uint64_t id) const;
+  // Where the target is: `spaceFromObject` in the space the caller keys `space` (update() says
+  // where the spaces are). A target takes part in grasps only while placed. Errors:
+  // invalid_argument (unknown id).
+  Status placeTarget(uint64_t id, uint64_t space, const Pose& spaceFromObject);
+  // The target takes part in nothing until placed again (its space was destroyed).
+  Status unplaceTarget(uint64_t id);
+  // The targets whose bounds overlap the box of half extents `half` at `worldFromBox`, in the
+  // spaces of the last update (the broad phase; for tools and tests).
+  std::vector<SceneHit> targetsNear(const Pose& worldFromBox, const glm::vec3& half) const;
   // The same, handing over `positions` and their bounds (computed by the caller while it filled
   // them): nothing is copied. Fill a buffer from vertexBuffer() to allocate nothing.
   Status updateTargetVertices(uint64_t id, std::vector<glm::vec3>&& positions, const Aabb& bounds);
@@ -178,7 +214,12 @@ class GraspSession {
   bool removeTarget(uint64_t id);
   bool hasTarget(uint64_t id) const { return targets_.count(id) != 0; }
 
-  // Advances one hand. Returns the first error met while solving (the hand then stays open).
+  // Advances one hand, with the spaces where they are this frame (targets in spaces not listed,
+  // or not valid, take part in nothing this frame). Returns the first error met while solving (the
+  // hand then stays open).
+  Status update(Hand hand, const HandFrame& frame, std::span<const SpaceFrame> spaces);
+  // The same with each target located on its own (placed in a space of its own at the identity;
+  // tests and tools).
   Status update(Hand hand, const HandFrame& frame, std::span<const TargetFrame> targets);
   void release(Hand hand);
 
@@ -216,7 +257,15 @@ class GraspSession {
 
  private:
   struct Target {
-    bool meshTarget = false;  // CPU arrays (addTarget), not device buffers
+    bool meshTarget = false;   // CPU arrays (addTarget), not device buffers
+    bool shapeTarget = false;  // an analytic shape (addShapeTarget)
+    std::optional<AnalyticShape> shape;
+    TargetRole role = TargetRole::graspable;
+    // Where it is (placeTarget); in the broad phase while placed, set up and not ignored.
+    bool placed = false;
+    uint64_t space = 0;
+    Pose spaceFromObject;
+    bool indexed = false;
     TargetSetup setup = TargetSetup::ready;
     // With a deferred backend that builds mesh targets: the arrays it uploads.
     std::unique_ptr<TriangleMesh> deviceCopy;
@@ -257,12 +306,21 @@ class GraspSession {
     // model's open hand (GraspScene::extraParts); 0 for a controller-driven hand.
     HandParts trackedParts{};
     int trackedPartCount = 0;
+    // The scene of the last job posted (its members, relative to the hand, and their versions):
+    // a change in it is what asks for a new solve.
+    std::vector<GraspWorker::JobMember> members;
+    std::vector<uint64_t> memberVersions;
+    // A solve took a target (HandGrasp::target): kept until the release. Until then every solve
+    // chooses again from what the fingers touch.
+    bool decided = false;
+    // The deferred build's scene (members[0] is the target it builds).
+    std::vector<GraspWorker::JobMember> pendingMembers;
   };
   // Sets hand.trackedParts from the frame's tracked joints (none: count 0). Before a solve.
   static void noteTrackedParts(HandState& hand, const HandFrame& frame);
 
-  Status solve(HandState& hand, size_t slot, uint64_t id, const Target& target,
-               const Pose& objectFromHand);
+  // Asks for a solve of the hand on `members` (the scene in its grab box, not empty).
+  Status solve(HandState& hand, size_t slot, std::vector<GraspWorker::JobMember> members);
   // Collects the hand's deferred build, if any, for the worker to solve on; on a device failure
   // has the worker redo it on the CPU.
   Status collect(HandState& hand, size_t slot);
@@ -271,23 +329,30 @@ class GraspSession {
   // A grab that failed: drops what is in flight, opens the hand, and starts no new grab until the
   // squeeze is released (HandState::waitForRelease).
   void giveUp(HandState& hand, size_t slot);
-  // Hands a build (none when `field` is set) and solve to the worker.
-  void post(HandState& hand, size_t slot, uint64_t id, const Pose& objectFromHand,
+  // Hands a build (of members other than members[0] when `field` holds that one) and solve to
+  // the worker.
+  void post(HandState& hand, size_t slot, std::vector<GraspWorker::JobMember> members,
             std::optional<SdfGrid> field, bool gpu, int64_t time);
   Status prepareSolver(HandState& hand);
   void refreshSetups();
   void cancelPending(HandState& hand, size_t slot);
-  // The target a grab of `side` takes: among those the hand may grasp whose bounds overlap the
-  // grab box, the one whose bounds' centre is nearest the box's centre (ties: the first in
-  // `targets`).
-  std::optional<uint64_t> pickTarget(Hand side, const Pose& worldFromWrist,
-                                     std::span<const TargetFrame> targets) const;
+  // The scene in the grab box of a hand at worldFromWrist: every placed, set-up target that is not
+  // ignored whose bounds overlap the box, relative to the hand, graspable when `side` may take it
+  // (the held target first, and always, when there is one and it is located). Device targets
+  // first otherwise (a deferred build takes members[0]). At most kMaxSceneMembers, the nearest.
+  std::vector<GraspWorker::JobMember> sceneInBox(Hand side, const Pose& worldFromWrist,
+                                                 uint64_t held) const;
+  // Whether `now` differs from the scene last solved on (members, versions, relative poses).
+  bool sceneChanged(const HandState& hand, std::span<const GraspWorker::JobMember> now) const;
+  // Puts the target in the broad phase, or takes it out, as its placement, set-up and role say.
+  void reindex(uint64_t id, Target& t);
 
   std::unique_ptr<DeferredSdfBackend> deferred_;
   bool deferredForMeshTargets_ = true;
   SdfBuildStats stats_;
   GraspSettings settings_;
   std::map<uint64_t, Target> targets_;
+  SceneIndex index_;
   std::vector<std::pair<uint64_t, MeshOrientation>> setupOrientations_;
   std::array<HandState, 2> hands_;
   std::vector<std::pair<uint64_t, std::string>> setupFailures_;

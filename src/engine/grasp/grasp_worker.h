@@ -35,6 +35,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
@@ -48,10 +49,14 @@
 #include "mesh/mesh.h"
 #include "mesh/mesh_distance.h"
 #include "mesh/mesh_orientation.h"
+#include "scene/analytic_shape.h"
+#include "scene/scene.h"
 #include "sdf/sdf_backend.h"
 #include "sdf/sdf_grid.h"
 
 namespace sdfg {
+
+class SceneExactSource;  // grasp/scene_exact_source.h
 
 enum class TargetSetup {
   unknown,  // no such target
@@ -90,17 +95,29 @@ class GraspWorker {
     bool reusesFields = false;
   };
 
-  // One hand's build and solve.
-  struct Job {
-    uint64_t ticket = 0;  // echoed in the result; the owner drops results of older tickets
+  // One solid of a job's scene: a target and where it is relative to the hand.
+  struct JobMember {
     uint64_t target = 0;
     Pose objectFromHand;
+    bool graspable = false;  // the job's hand may take it
+  };
+
+  // One hand's build and solve, on the scene in its grab box.
+  struct Job {
+    uint64_t ticket = 0;  // echoed in the result; the owner drops results of older tickets
+    // Every target in the grab box (scene/scene.h); members[0] is the one a GPU-built `field`
+    // holds. Targets with neither a CPU mesh nor a shape (device buffers) take part only
+    // through that field.
+    std::vector<JobMember> members;
+    // The target the hand holds: it keeps it whatever the fingers touch. 0: the grasp takes the
+    // graspable target the closing hand touches (grasp/target_choice.h), or nothing.
+    uint64_t held = 0;
     GridBox box;
     std::shared_ptr<SolverSetup> solver;
-    bool exactCheck = true;  // give the solver the target's exact distance
+    bool exactCheck = true;  // give the solver the scene's exact distance
     // The longest the CPU build may take; past it the job ends with timed_out.
     std::chrono::milliseconds buildTimeLimit{1000};
-    // A field built elsewhere (the GPU): solve on it, build nothing.
+    // A field of members[0] built elsewhere (the GPU): the others are merged into it on the CPU.
     std::optional<SdfGrid> field;
     int64_t time = 0;  // the frame time the hand and target poses belong to, echoed in Done
     // A tracked hand's open-hand parts to clear besides the model's (GraspScene::extraParts).
@@ -112,12 +129,21 @@ class GraspWorker {
     uint64_t ticket = 0;
     Status status = Status::ok;
     GraspResult result{};
-    FingerContacts contacts{};  // computeContacts() of `result`, done here, off the app's thread
-    int64_t time = 0;           // Job::time
-    Pose objectFromHand;
-    uint64_t version = 0;  // the target's vertex version the result was solved on
-    bool built = false;    // a grab-box SDF was built on the CPU for it
-    bool reused = false;   // solved on the slot's last field, moved rigidly (nothing built)
+    // computeContacts() of `result` on the chosen target, done here, off the app's thread; a
+    // finger that touches another target has no contact here (see `touched`).
+    FingerContacts contacts{};
+    int64_t time = 0;  // Job::time
+    // The target the hand takes (Job::held when set); 0: it holds nothing (its fingers rest on
+    // scene geometry, or on nothing).
+    uint64_t chosen = 0;
+    // Per finger, the target its contact is on (0: no contact).
+    std::array<uint64_t, kFingerCount> touched{};
+    Pose objectFromHand;   // the chosen target's, from the job (identity when none)
+    uint64_t version = 0;  // the chosen target's vertex version the result was solved on
+    // Every member's vertex version the result was solved on, in Job::members order.
+    std::vector<uint64_t> versions;
+    bool built = false;   // a grab-box SDF was built on the CPU for it
+    bool reused = false;  // solved on the slot's last field, moved rigidly (nothing built)
     std::chrono::microseconds duration{0};
   };
 
@@ -132,6 +158,8 @@ class GraspWorker {
   // the mesh (validateMesh: the app's thread checks only what it can in one streaming pass), and
   // fails with its message when it is refused.
   void addTarget(uint64_t id, TriangleMesh mesh);
+  // A target that is an analytic shape (scene/analytic_shape.h): ready at once.
+  void addShape(uint64_t id, const AnalyticShape& shape);
   // New positions (same count as the mesh) of vertex version `version`; applied before the next
   // build of the target. Unknown ids are ignored. Positions that collapse a triangle are refused
   // when they are applied: the target keeps its last shape (takeRefusedUpdates says so).
@@ -167,6 +195,7 @@ class GraspWorker {
     // refit in flight stops (the object is dropped, so a half-refit one is never used again).
     std::atomic<bool> stop{false};
     std::shared_ptr<MeshDistance> distance;           // touched by the worker thread only
+    std::optional<AnalyticShape> shape;               // a shape target (no mesh)
     std::optional<TriangleMesh> setupMesh;            // waiting for its set-up
     std::optional<std::vector<glm::vec3>> positions;  // waiting for the next build
     // Used positions buffers, handed out again (spareBuffer). Three circulate for a mesh that
@@ -186,8 +215,8 @@ class GraspWorker {
     std::optional<Job> queued;
     bool running = false;
     uint64_t runningTicket = 0;
-    uint64_t runningTarget = 0;
-    uint64_t cancelledBelow = 0;  // results of tickets below this are dropped
+    std::vector<uint64_t> runningTargets;  // the running job's members
+    uint64_t cancelledBelow = 0;           // results of tickets below this are dropped
     std::optional<Done> done;
   };
 
@@ -201,6 +230,11 @@ class GraspWorker {
   void run();
   void runSetup(std::unique_lock<std::mutex>& lock, uint64_t id, std::shared_ptr<Target> target);
   void runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job job);
+  // After the solve: which target the hand takes, what each finger touches, and the contacts on
+  // the target taken (Done::chosen, touched, contacts, objectFromHand, version).
+  static void chooseAndContact(const Job& job, std::span<const SceneMember> scene,
+                               std::span<const size_t> sceneIndex, const SceneExactSource& exact,
+                               const SdfGrid* field, Done& done);
 
   // The field a slot built last, for what it was built (worker thread only). A later job of the
   // same target and vertices whose whole box, moved rigidly to the new relative pose, still lies
@@ -211,16 +245,19 @@ class GraspWorker {
   struct BuiltField {
     SdfGrid grid;
     bool valid = false;
-    uint64_t target = 0;
-    uint64_t version = 0;
-    Pose objectFromHand;
+    std::vector<uint64_t> targets;   // the scene's members
+    std::vector<uint64_t> versions;  // their vertex versions
+    std::vector<Pose> objectFromHand;
     GridBox jobBox;  // the box the job asked for (the grid's may be grown)
   };
-  // The map from the job's hand frame into the field's, when the field covers the job.
-  static std::optional<Pose> reuseMap(const BuiltField& built, const Job& job, uint64_t version);
+  // The map from the job's hand frame into the field's, when the field covers the job: the same
+  // members at the same versions, all moved by one rigid motion relative to the hand.
+  static std::optional<Pose> reuseMap(const BuiltField& built, const Job& job,
+                                      std::span<const uint64_t> versions);
 
   std::unique_ptr<SdfBackend> backend_;  // worker thread only
   std::array<BuiltField, kSlots> fields_;
+  std::array<SdfGrid, kSlots> scratch_;  // the scene field's per-member builds
 
   // Set to stop the build a slot's job runs (WorkLimit::stop): by cancel() and removeTarget() of
   // the job's target, and by the destructor; cleared when the slot's next job starts.

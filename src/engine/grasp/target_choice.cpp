@@ -17,7 +17,8 @@ float distanceTo(const SceneMember& m, const glm::vec3& hand) {
 }  // namespace
 
 GraspChoice chooseTarget(std::span<const SceneMember> members, const ExactDistanceSource& scene,
-                         const GraspResult& result, const glm::vec3& palm, float reach) {
+                         const GraspResult& result, const glm::vec3& palm, float palmRadius,
+                         float reach) {
   GraspChoice out;
   std::array<glm::vec3, 1> point{};
   std::array<float, 1> bound{reach};
@@ -37,9 +38,11 @@ GraspChoice chooseTarget(std::span<const SceneMember> members, const ExactDistan
   const glm::vec3 palmScene = result.handCorrection.transformPoint(palm);
   float bestPalm = std::numeric_limits<float>::infinity();
   for (size_t m = 0; m < members.size(); ++m) {
-    if (!members[m].graspable || count[m] == 0) continue;
+    if (!members[m].graspable) continue;
     if (out.member >= 0 && count[m] < out.fingersOnChoice) continue;
     const float palmDistance = distanceTo(members[m], palmScene);
+    // Untouched: no finger on it, and the palm's surface not near it.
+    if (count[m] == 0 && palmDistance - palmRadius > kPalmTouch) continue;
     const bool better =
         out.member < 0 || count[m] > out.fingersOnChoice || palmDistance < bestPalm ||
         (palmDistance == bestPalm && members[m].id < members[size_t(out.member)].id);

@@ -2,14 +2,18 @@
 // one whose bounding box happens to be nearest (XR_SDFG_auto_grasp version 3).
 //
 // After the fingers have closed on the whole scene, each finger in contact touches the member
-// that owns the nearest surface at its touching sphere. The rule, deterministic:
-//   1. among the members the hand may take (SceneMember::graspable), the one the most fingers
-//      touch;
+// that owns the nearest surface at its touching sphere, and the palm touches every member its
+// surface is within kPalmTouch of. The rule, deterministic:
+//   1. among the members the hand may take (SceneMember::graspable) that the hand touches (a
+//      finger, or the palm), the one the most fingers touch;
 //   2. between those, the one whose surface is nearest the palm (exact distance of the palm
 //      joint's centre);
 //   3. between those, the lowest id.
-// A member no finger touches is never taken; when the fingers touch only scene geometry, or
-// nothing, the hand holds nothing (its fingers still rest on what they touch).
+// A member the hand does not touch is never taken (one behind another, say); when it touches
+// only scene geometry, or nothing, the hand holds nothing (its fingers still rest on what they
+// touch). The palm counts because a flat object under it (a comb on a table) is often touched by
+// no finger: they close past it onto the table, and the thumb, lower than the palm, keeps the
+// palm's own surface a centimetre or more above it.
 #pragma once
 
 #include <array>
@@ -31,11 +35,15 @@ struct GraspChoice {
   int fingersOnChoice = 0;
 };
 
+// The palm touches a member whose surface is within this of the palm joint's sphere.
+inline constexpr float kPalmTouch = 0.02f;  // metres
+
 // `scene`: the members' exact source (the one the solve used); `result`: the solve (contact
-// points in its corrected hand frame); `palm`: the palm joint's centre in the same frame as the
-// contact points; `reach`: how far from a touching sphere's centre its surface may be (the
-// sphere's radius plus the solver's tolerance; metres).
+// points in its corrected hand frame); `palm`, `palmRadius`: the palm joint's centre in the same
+// frame as the contact points, and its radius; `reach`: how far from a touching sphere's centre
+// its surface may be (the sphere's radius plus the solver's tolerance; metres).
 GraspChoice chooseTarget(std::span<const SceneMember> members, const ExactDistanceSource& scene,
-                         const GraspResult& result, const glm::vec3& palm, float reach);
+                         const GraspResult& result, const glm::vec3& palm, float palmRadius,
+                         float reach);
 
 }  // namespace sdfg

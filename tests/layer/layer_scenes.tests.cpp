@@ -1,0 +1,305 @@
+// XR_SDFG_auto_grasp version 3, scenes, through the loader: every target in the grab box takes
+// part, roles (graspable, scene geometry, ignored), analytic shapes, which target a grab takes
+// (the rule in the header), and what each finger touches.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "grasp_v2.h"
+#include "scene/analytic_shape.h"
+
+namespace {
+
+using namespace sdfg;
+using namespace sdfg::test;
+
+const XrPosef kGrip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+
+XrGraspTargetSDFG makeShape(const GraspRun& run, XrGraspShapeTypeSDFG type, const XrVector3f& half,
+                            const XrPosef& pose, XrGraspTargetRoleSDFG role) {
+  XrGraspTargetShapeSDFG shape{XR_TYPE_GRASP_TARGET_SHAPE_SDFG, nullptr, type, half};
+  XrGraspTargetRoleInfoSDFG r{XR_TYPE_GRASP_TARGET_ROLE_SDFG, &shape, role};
+  XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &r};
+  ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, run.app->local, pose};
+  XrGraspTargetSDFG t = XR_NULL_HANDLE;
+  REQUIRE(run.ext->create(run.app->session, &ci, &t) == XR_SUCCESS);
+  return t;
+}
+
+void setRole(const GraspRun& run, XrGraspTargetSDFG target, XrGraspTargetRoleSDFG role,
+             XrGraspHandFlagsSDFG hands = XR_GRASP_HAND_LEFT_BIT_SDFG |
+                                          XR_GRASP_HAND_RIGHT_BIT_SDFG) {
+  auto set = run.app->fn<PFN_xrSetGraspTargetSettingsSDFG>("xrSetGraspTargetSettingsSDFG");
+  REQUIRE(set != nullptr);
+  XrGraspTargetRoleInfoSDFG r{XR_TYPE_GRASP_TARGET_ROLE_SDFG, nullptr, role};
+  XrGraspTargetSettingsSDFG s{XR_TYPE_GRASP_TARGET_SETTINGS_SDFG, &r, hands};
+  REQUIRE(set(target, &s) == XR_SUCCESS);
+}
+
+struct Touches {
+  XrGraspStateSDFG state{XR_TYPE_GRASP_STATE_SDFG};
+  XrGraspTouchesSDFG touches{XR_TYPE_GRASP_TOUCHES_SDFG};
+};
+
+Touches touchesOf(const GraspRun& run) {
+  Touches t;
+  t.state.next = &t.touches;
+  REQUIRE(run.state(t.state) == XR_SUCCESS);
+  return t;
+}
+
+// Fingers per touched target.
+std::map<XrGraspTargetSDFG, int> fingersOn(const XrGraspTouchesSDFG& t) {
+  std::map<XrGraspTargetSDFG, int> out;
+  for (XrGraspTargetSDFG target : t.touched)
+    if (target != XR_NULL_HANDLE) ++out[target];
+  return out;
+}
+
+// The deepest any joint sphere of the located hand is inside an axis-aligned box (LOCAL), metres
+// (0: none inside).
+float deepestInBox(const Joints& joints, const AnalyticShape& box, const XrPosef& pose) {
+  const Pose boxFromLocal = toPose(pose).inverse();
+  float deepest = 0.0f;
+  for (const XrHandJointLocationEXT& j : joints.joints) {
+    const glm::vec3 p = boxFromLocal.transformPoint(
+        glm::vec3(j.pose.position.x, j.pose.position.y, j.pose.position.z));
+    deepest = std::max(deepest, j.radius - box.signedDistance(p));
+  }
+  return deepest;
+}
+
+// An orientation whose +Y points out of the open right hand's palm side toward the palm (so a
+// box placed with it lies flat under the palm) and +X across the fingers.
+XrQuaternionf facingPalm(const XrPosef& grip) {
+  const OpenRightHand hand = openRightHand(grip);
+  const glm::vec3 y = -hand.down;
+  const glm::vec3 x = glm::normalize(hand.across - glm::dot(hand.across, y) * y);
+  const glm::quat q = glm::quat_cast(glm::mat3(x, y, glm::cross(x, y)));
+  return {q.x, q.y, q.z, q.w};
+}
+
+// A table top (a box) whose top face is just under the open right hand's palm side, 3 mm clear of
+// it, centred under the palm: the pose of its centre, its half extents.
+struct Table {
+  XrPosef pose;
+  XrVector3f half{0.3f, 0.02f, 0.3f};
+};
+
+Table tableUnderPalm(const XrPosef& grip) {
+  const TestMesh slab = toTestMesh(makeBox(glm::vec3(0.6f, 0.04f, 0.6f)));
+  Table t;
+  t.pose = belowOpenRightPalm(slab, grip, facingPalm(grip));
+  return t;
+}
+
+// `p` moved by `d` along the open right palm's normal (away from the palm).
+XrPosef awayFromPalm(const XrPosef& grip, XrPosef p, float d) {
+  const glm::vec3 down = openRightHand(grip).down;
+  p.position = {p.position.x + down.x * d, p.position.y + down.y * d, p.position.z + down.z * d};
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("A squeeze with only scene geometry in reach closes on it and holds nothing",
+          "[layer][scenes]") {
+  const TestMesh far = makeIcosphere(0.02f, 2);
+  GraspRun run(far, {{0, 0, 0, 1}, {5.0f, 0.0f, 0.0f}}, kGrip);  // the run's target out of reach
+  const Table table = tableUnderPalm(kGrip);
+  const XrGraspTargetSDFG top = makeShape(run, XR_GRASP_SHAPE_TYPE_BOX_SDFG, table.half, table.pose,
+                                          XR_GRASP_TARGET_ROLE_SCENE_SDFG);
+  REQUIRE(runUntil(*run.app, [&] { return touchesOf(run).touches.isClosed == XR_TRUE; }));
+  const Touches t = touchesOf(run);
+  CHECK_FALSE(t.state.isGrasping);
+  CHECK(t.state.target == XR_NULL_HANDLE);
+  // The fingers that touch anything touch the table.
+  const auto on = fingersOn(t.touches);
+  REQUIRE_FALSE(on.empty());
+  CHECK(on.count(top) == 1);
+  CHECK(on.size() == 1);
+  Joints joints;
+  REQUIRE(locateJoints(*run.app, run.tracker, joints) == XR_SUCCESS);
+  CHECK(deepestInBox(joints, {ShapeKind::box, {table.half.x, table.half.y, table.half.z}},
+                     table.pose) <= 0.001f);
+  CHECK(validationLog().empty());
+}
+
+TEST_CASE("A flat object on a table: the grab takes the object, no hand part enters the table",
+          "[layer][scenes]") {
+  // A flat bar (a comb's size: 12 x 0.8 x 3 cm) lying on the table under the palm.
+  const TestMesh bar = toTestMesh(makeBox(glm::vec3(0.12f, 0.008f, 0.03f)));
+  const XrPosef barPose = belowOpenRightPalm(bar, kGrip, facingPalm(kGrip));
+  const bool tableGraspable = GENERATE(false, true);
+  CAPTURE(tableGraspable);
+  GraspRun run(bar, barPose, kGrip);
+  // The table's top just under the bar (the bar rests on it).
+  Table table;
+  table.pose = awayFromPalm(kGrip, barPose, 0.004f + table.half.y);
+  const XrGraspTargetSDFG top = makeShape(
+      run, XR_GRASP_SHAPE_TYPE_BOX_SDFG, table.half, table.pose,
+      tableGraspable ? XR_GRASP_TARGET_ROLE_GRASPABLE_SDFG : XR_GRASP_TARGET_ROLE_SCENE_SDFG);
+  REQUIRE(untilSetUp(*run.app, *run.ext, [](const auto& s) { return s.readyCount >= 2; }));
+  REQUIRE(runUntil(*run.app, [&] { return touchesOf(run).touches.isClosed == XR_TRUE; }));
+  const Touches t = touchesOf(run);
+  const auto on = fingersOn(t.touches);
+  if (!tableGraspable) {
+    // Scene geometry is never taken: the bar, under the palm (the fingers may close past it
+    // onto the table; the palm touching it counts).
+    CHECK(t.state.isGrasping);
+    CHECK(t.state.target == run.target);
+  } else {
+    // The documented rule: the graspable target the most fingers touch.
+    REQUIRE(t.state.isGrasping);
+    const int onTaken = on.count(t.state.target) ? on.at(t.state.target) : 0;
+    for (const auto& [target, fingers] : on) CHECK(onTaken >= fingers);
+    CHECK((t.state.target == run.target || t.state.target == top));
+  }
+  Joints joints;
+  REQUIRE(locateJoints(*run.app, run.tracker, joints) == XR_SUCCESS);
+  CHECK(deepestInBox(joints, {ShapeKind::box, {table.half.x, table.half.y, table.half.z}},
+                     table.pose) <= 0.001f);
+  CHECK(validationLog().empty());
+}
+
+TEST_CASE("A target behind scene geometry is never taken: the fingers stop on what is in front",
+          "[layer][scenes]") {
+  // A graspable sphere in the box, and a wall (scene) between the palm and it: the wall's near
+  // face 3 mm under the palm, the sphere beyond it.
+  const Table wall = tableUnderPalm(kGrip);
+  const OpenRightHand hand = openRightHand(kGrip);
+  const glm::vec3 behind = hand.palm + hand.down * (2.0f * wall.half.y + 0.06f);
+  const TestMesh ball = makeIcosphere(0.025f, 3);
+  GraspRun run(ball, {{0, 0, 0, 1}, {behind.x, behind.y, behind.z}}, kGrip);
+  const XrGraspTargetSDFG w = makeShape(run, XR_GRASP_SHAPE_TYPE_BOX_SDFG, wall.half, wall.pose,
+                                        XR_GRASP_TARGET_ROLE_SCENE_SDFG);
+  REQUIRE(untilSetUp(*run.app, *run.ext, [](const auto& s) { return s.readyCount >= 2; }));
+  REQUIRE(runUntil(*run.app, [&] { return touchesOf(run).touches.isClosed == XR_TRUE; }));
+  const Touches t = touchesOf(run);
+  CHECK_FALSE(t.state.isGrasping);
+  const auto on = fingersOn(t.touches);
+  CHECK(on.count(run.target) == 0);
+  CHECK(on.count(w) == 1);
+  CHECK(validationLog().empty());
+}
+
+TEST_CASE("Two touching objects: the grab takes the one most fingers touch, the other stops them",
+          "[layer][scenes]") {
+  // Two balls side by side across the fingers, touching each other, under the palm.
+  const TestMesh ball = makeIcosphere(0.025f, 3);
+  const OpenRightHand hand = openRightHand(kGrip);
+  const XrPosef first = belowOpenRightPalm(ball, kGrip, {0, 0, 0, 1}, hand.across * -0.0125f);
+  XrPosef second = first;
+  second.position.x += hand.across.x * 0.05f;
+  second.position.y += hand.across.y * 0.05f;
+  second.position.z += hand.across.z * 0.05f;
+  GraspRun run(ball, first, kGrip);
+  const XrGraspTargetSDFG other = makeTarget(*run.app, *run.ext, ball, second);
+  REQUIRE(untilSetUp(*run.app, *run.ext, [](const auto& s) { return s.readyCount >= 2; }));
+  REQUIRE(runUntil(*run.app, [&] { return run.grasping(); }));
+  const Touches t = touchesOf(run);
+  const auto on = fingersOn(t.touches);
+  const int onTaken = on.count(t.state.target) ? on.at(t.state.target) : 0;
+  CHECK(onTaken >= 1);
+  for (const auto& [target, fingers] : on) CHECK(onTaken >= fingers);
+  CHECK((t.state.target == run.target || t.state.target == other));
+  // No part of either ball is inside a finger's joint sphere.
+  Joints joints;
+  REQUIRE(locateJoints(*run.app, run.tracker, joints) == XR_SUCCESS);
+  for (const XrPosef& centre : {first, second}) {
+    for (const XrHandJointLocationEXT& j : joints.joints) {
+      const float d = length(sub(j.pose.position, centre.position)) - 0.025f;
+      CHECK(d - j.radius >= -0.001f);
+    }
+  }
+  CHECK(validationLog().empty());
+}
+
+TEST_CASE("An ignored target is passed through, and roles change from the next sync",
+          "[layer][scenes]") {
+  const TestMesh ball = makeIcosphere(0.03f, 3);
+  const XrPosef under = belowOpenRightPalm(ball, kGrip, {0, 0, 0, 1});
+  GraspRun run(ball, under, kGrip);
+  setRole(run, run.target, XR_GRASP_TARGET_ROLE_IGNORED_SDFG);
+  REQUIRE(untilSetUp(*run.app, *run.ext, [](const auto& s) { return s.readyCount >= 1; }));
+  // Squeezing: nothing in reach closes the hand (a grab would show within a second: a solve takes
+  // tens of milliseconds on the worker).
+  REQUIRE(runUntil(*run.app, [&] { return touchesOf(run).state.squeeze >= 0.99f; }));
+  CHECK_FALSE(runUntil(
+      *run.app, [&] { return touchesOf(run).touches.isClosed == XR_TRUE; },
+      std::chrono::seconds(1)));
+  setRole(run, run.target, XR_GRASP_TARGET_ROLE_GRASPABLE_SDFG);
+  REQUIRE(runUntil(*run.app, [&] { return run.grasping(); }));
+  // Scene geometry from now: the hand lets go, and holds nothing while it rests on it.
+  setRole(run, run.target, XR_GRASP_TARGET_ROLE_SCENE_SDFG);
+  REQUIRE(runUntil(*run.app, [&] { return !run.grasping(); }));
+  CHECK(validationLog().empty());
+}
+
+TEST_CASE("Bad roles and shapes are refused and change nothing", "[layer][scenes][bad_input]") {
+  const TestMesh ball = makeIcosphere(0.03f, 2);
+  GraspRun run(ball, {{0, 0, 0, 1}, {5.0f, 0.0f, 0.0f}}, kGrip);
+  const XrPosef somewhere{{0, 0, 0, 1}, {0, -1, -1}};
+  auto tryShape = [&](int32_t type, XrVector3f half, int32_t role) {
+    XrGraspTargetShapeSDFG shape{XR_TYPE_GRASP_TARGET_SHAPE_SDFG, nullptr,
+                                 XrGraspShapeTypeSDFG(type), half};
+    XrGraspTargetRoleInfoSDFG r{XR_TYPE_GRASP_TARGET_ROLE_SDFG, &shape,
+                                XrGraspTargetRoleSDFG(role)};
+    XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &r};
+    ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, run.app->local, somewhere};
+    XrGraspTargetSDFG t = reinterpret_cast<XrGraspTargetSDFG>(uintptr_t(77));
+    const XrResult result = run.ext->create(run.app->session, &ci, &t);
+    // Nothing written on failure.
+    if (result != XR_SUCCESS) CHECK(t == reinterpret_cast<XrGraspTargetSDFG>(uintptr_t(77)));
+    return result;
+  };
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  CHECK(tryShape(XR_GRASP_SHAPE_TYPE_BOX_SDFG, {0.1f, 0.1f, 0.1f}, 3) ==
+        XR_ERROR_VALIDATION_FAILURE);
+  CHECK(tryShape(XR_GRASP_SHAPE_TYPE_BOX_SDFG, {0.1f, 0.1f, 0.1f}, -1) ==
+        XR_ERROR_VALIDATION_FAILURE);
+  CHECK(tryShape(XR_GRASP_SHAPE_TYPE_BOX_SDFG, {nan, 0.1f, 0.1f}, 0) ==
+        XR_ERROR_VALIDATION_FAILURE);
+  CHECK(tryShape(XR_GRASP_SHAPE_TYPE_BOX_SDFG, {0.1f, -0.1f, 0.1f}, 0) ==
+        XR_ERROR_VALIDATION_FAILURE);
+  CHECK(tryShape(XR_GRASP_SHAPE_TYPE_BOX_SDFG, {0.1f, 0.1f, inf}, 0) ==
+        XR_ERROR_VALIDATION_FAILURE);
+  CHECK(tryShape(XR_GRASP_SHAPE_TYPE_BOX_SDFG, {0.0f, 0.1f, 0.1f}, 0) ==
+        XR_ERROR_VALIDATION_FAILURE);
+  CHECK(tryShape(XR_GRASP_SHAPE_TYPE_PLANE_SDFG, {0.1f, 0.0f, 0.0f}, 0) ==
+        XR_ERROR_VALIDATION_FAILURE);
+  CHECK(tryShape(7, {0.1f, 0.1f, 0.1f}, 0) == XR_ERROR_VALIDATION_FAILURE);
+  // A shape and vertices together: not exactly one mesh struct.
+  {
+    XrGraspTargetVerticesSDFG v{XR_TYPE_GRASP_TARGET_VERTICES_SDFG};
+    v.vertexCount = uint32_t(ball.vertices.size());
+    v.vertices = ball.vertices.data();
+    v.indexCount = uint32_t(ball.indices.size());
+    v.indices = ball.indices.data();
+    XrGraspTargetShapeSDFG shape{
+        XR_TYPE_GRASP_TARGET_SHAPE_SDFG, &v, XR_GRASP_SHAPE_TYPE_BOX_SDFG, {0.1f, 0.1f, 0.1f}};
+    XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &shape};
+    ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, run.app->local, somewhere};
+    XrGraspTargetSDFG t = XR_NULL_HANDLE;
+    CHECK(run.ext->create(run.app->session, &ci, &t) == XR_ERROR_VALIDATION_FAILURE);
+  }
+  // A good shape, then the calls a shape refuses.
+  REQUIRE(tryShape(XR_GRASP_SHAPE_TYPE_PLANE_SDFG, {0, 0, 0}, 1) == XR_SUCCESS);
+  const XrGraspTargetSDFG box = makeShape(run, XR_GRASP_SHAPE_TYPE_BOX_SDFG, {0.1f, 0.1f, 0.1f},
+                                          somewhere, XR_GRASP_TARGET_ROLE_GRASPABLE_SDFG);
+  XrGraspTargetVerticesSDFG moved{XR_TYPE_GRASP_TARGET_VERTICES_SDFG};
+  moved.vertexCount = uint32_t(ball.vertices.size());
+  moved.vertices = ball.vertices.data();
+  CHECK(run.ext->update(box, &moved) == XR_ERROR_VALIDATION_FAILURE);
+  auto set = run.app->fn<PFN_xrSetGraspTargetSettingsSDFG>("xrSetGraspTargetSettingsSDFG");
+  XrGraspTargetRoleInfoSDFG badRole{XR_TYPE_GRASP_TARGET_ROLE_SDFG, nullptr,
+                                    XrGraspTargetRoleSDFG(9)};
+  XrGraspTargetSettingsSDFG s{XR_TYPE_GRASP_TARGET_SETTINGS_SDFG, &badRole,
+                              XR_GRASP_HAND_RIGHT_BIT_SDFG};
+  CHECK(set(box, &s) == XR_ERROR_VALIDATION_FAILURE);
+  CHECK(validationLog().empty());
+}

@@ -48,7 +48,10 @@ const char* const kKeys[] = {"log_level",
                              "approach_max_angle",
                              "offset_blend_time",
                              "build_time_limit_ms",
-                             "test_layer_fault"};
+                             "test_layer_fault",
+                             "outer_hand",
+                             "outer_release_distance",
+                             "outer_blend_time"};
 
 }  // namespace
 
@@ -105,6 +108,12 @@ bool applyConfigValue(Config& config, const std::string& key, const std::string&
     ok = parseFloat(value, 0.1f, 180.0f, c.approachMaxAngle);
   } else if (key == "offset_blend_time") {
     ok = parseFloat(value, 0.0f, 2.0f, c.offsetBlendTime);
+  } else if (key == "outer_hand") {
+    ok = parseBool(value, c.outerHand);
+  } else if (key == "outer_release_distance") {
+    ok = parseFloat(value, 0.01f, 1.0f, c.outerReleaseDistance);
+  } else if (key == "outer_blend_time") {
+    ok = parseFloat(value, 0.0f, 2.0f, c.outerBlendTime);
   } else if (key == "test_layer_fault") {
     ok = value == "none" || value == "after_create_instance" || value == "after_create_session" ||
          value == "after_create_space" || value == "after_create_tracker";

@@ -48,6 +48,11 @@ struct Config {
   float approachRange = 0.03f;
   float approachMaxAngle = 30.0f;
   float offsetBlendTime = 0.1f;
+  // The outer hand (docs/layer.md, "The outer hand"): outer_hand, outer_release_distance
+  // (metres), outer_blend_time (seconds).
+  bool outerHand = true;
+  float outerReleaseDistance = 0.10f;
+  float outerBlendTime = 0.25f;
 };
 
 Config loadConfig();

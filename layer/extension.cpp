@@ -637,6 +637,8 @@ XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession session,
               XR_ERROR_VALIDATION_FAILURE, "(options->grabThreshold) must be 0 or in (0, 1]");
   ClearanceRequest clearance;
   if (XrResult r = readClearanceOptions(cmd, o.next, clearance); r != XR_SUCCESS) return r;
+  OuterHandRequest outer;
+  if (XrResult r = readOuterHandOptions(cmd, o.next, outer); r != XR_SUCCESS) return r;
 
   std::unique_lock lock(s->mutex);
   if (s->grasp == nullptr) {
@@ -656,6 +658,7 @@ XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession session,
   if (o.grabThreshold != 0.0f) settings.grabThreshold = o.grabThreshold;
   float blendTime = s->instance->config.offsetBlendTime;
   clearance.apply(settings, blendTime);
+  outer.apply(settings);
   if (Status st = s->grasp->configure(settings); st != Status::ok) {
     lock.unlock();
     return logError(st == Status::invalid_argument && solver == XR_GRASP_SOLVER_OURS_SDFG

@@ -28,7 +28,9 @@ void writeHandOffset(const SessionState& s, int h, void* next) {
   if (out == nullptr) return;
   const HandOffset& o = s.offsets.hands[size_t(h)];
   const bool held = s.grasp->grasp(h == 0 ? Hand::left : Hand::right).shown();
-  out->offset = toXr(shownHandOffset(o));
+  // The whole offset drawn now: the outer hand's, then the grasp's (the published view's).
+  const std::shared_ptr<const ShownHand> view = s.shown[size_t(h)].load();
+  out->offset = toXr(view != nullptr ? shownWholeOffset(*view) : shownHandOffset(o));
   out->solvedOffset = toXr(held ? o.solved : Pose{});
   out->blend = o.blend;
   out->openClearance = held ? o.openClearance : 0.0f;
@@ -67,6 +69,35 @@ XrResult readClearanceOptions(const char* cmd, const void* next, ClearanceReques
                     "(clearanceOptions->blendTime) must be 0 or in (0, 2]");
   out.present = true;
   out.options = *c;
+  return XR_SUCCESS;
+}
+
+void OuterHandRequest::apply(GraspSettings& settings) const {
+  if (!present) return;
+  if (options.outerHand != XR_GRASP_SWITCH_DEFAULT_SDFG)
+    settings.outerHand = options.outerHand == XR_GRASP_SWITCH_ON_SDFG;
+  if (options.releaseDistance != 0.0f)
+    settings.outerOptions.releaseDistance = options.releaseDistance;
+  if (options.blendTime != 0.0f) settings.outerOptions.blendTime = options.blendTime;
+}
+
+XrResult readOuterHandOptions(const char* cmd, const void* next, OuterHandRequest& out) {
+  const auto* o =
+      findInChain<const XrGraspOuterHandOptionsSDFG>(next, XR_TYPE_GRASP_OUTER_HAND_OPTIONS_SDFG);
+  out = OuterHandRequest{};
+  if (o == nullptr) return XR_SUCCESS;
+  const int sw = int(o->outerHand);
+  if (sw < int(XR_GRASP_SWITCH_DEFAULT_SDFG) || sw > int(XR_GRASP_SWITCH_ON_SDFG))
+    return logError(XR_ERROR_VALIDATION_FAILURE, cmd, "(outerHandOptions->outerHand) is %d", sw);
+  auto inRange = [](float v, float hi) { return v == 0.0f || (v > 0.0f && v <= hi); };
+  if (!inRange(o->releaseDistance, 1.0f))
+    return logError(XR_ERROR_VALIDATION_FAILURE, cmd,
+                    "(outerHandOptions->releaseDistance) must be 0 or in (0, 1]");
+  if (!inRange(o->blendTime, 2.0f))
+    return logError(XR_ERROR_VALIDATION_FAILURE, cmd,
+                    "(outerHandOptions->blendTime) must be 0 or in (0, 2]");
+  out.present = true;
+  out.options = *o;
   return XR_SUCCESS;
 }
 

@@ -1,5 +1,6 @@
 // The hand's offset off its tracked pose as the extension sees it (issue 21: the hand never
-// starts inside): the options that shape it (XrGraspClearanceOptionsSDFG) and the report of it
+// starts inside; issue 27: the outer hand stays out in every frame): the options that shape it
+// (XrGraspClearanceOptionsSDFG, XrGraspOuterHandOptionsSDFG) and the report of it
 // (XrGraspHandOffsetSDFG). The offset itself, its blend and how it moves the joints are the
 // engine's (grasp/hand_offset_blend.h).
 #pragma once
@@ -26,6 +27,17 @@ struct ClearanceRequest {
   XrGraspClearanceOptionsSDFG options{};
   void apply(GraspSettings& settings, float& blendTime) const;
 };
+
+// What XrGraspOuterHandOptionsSDFG asked for, checked; applied to the settings by apply().
+struct OuterHandRequest {
+  bool present = false;
+  XrGraspOuterHandOptionsSDFG options{};
+  void apply(GraspSettings& settings) const;
+};
+
+// Checks the XrGraspOuterHandOptionsSDFG chained on `next`, if any: XR_SUCCESS (and `out` set)
+// or XR_ERROR_VALIDATION_FAILURE, logged under `cmd`.
+XrResult readOuterHandOptions(const char* cmd, const void* next, OuterHandRequest& out);
 
 // Fills the XrGraspHandOffsetSDFG chained on `next`, if any, for hand `h`. The caller holds the
 // session's mutex.

@@ -97,6 +97,9 @@ GraspSettings settingsFromConfig(const Config& config) {
   s.solverOptions.approach = config.approach;
   s.solverOptions.approachRange = config.approachRange;
   s.solverOptions.approachMaxAngle = config.approachMaxAngle * 3.14159265f / 180.0f;
+  s.outerHand = config.outerHand;
+  s.outerOptions.releaseDistance = config.outerReleaseDistance;
+  s.outerOptions.blendTime = config.outerBlendTime;
   return s;
 }
 

@@ -436,11 +436,14 @@ typedef enum XrGraspSwitchSDFG {
 } XrGraspSwitchSDFG;
 
 // Optional output, chained on XrGraspStateSDFG::next: how far the layer moved the hand off the
-// tracked (or controller-driven) pose so that no part of it is inside the held object. Every one
-// of the 26 joints xrLocateHandJointsEXT returns is moved by `offset`: a joint's shown pose is
+// tracked (or controller-driven) pose so that no part of it is inside the held object, nor (with
+// the outer hand, XrGraspOuterHandOptionsSDFG) inside any target, in every frame. Every one of the
+// 26 joints xrLocateHandJointsEXT returns is moved by `offset`: a joint's shown pose is
 // trackedWrist * offset * (trackedWrist^-1 * jointPose), with trackedWrist the wrist joint as
-// tracked (or as the layer synthesizes it from the grip pose). An app that draws its own
-// controller or arm applies the same `offset` to it in the wrist frame to follow the hand.
+// tracked (or as the layer synthesizes it from the grip pose); fingers the outer hand stops on a
+// surface are curled less besides. An app that draws its own controller or arm applies the same
+// `offset` to it in the wrist frame to follow the hand. The fields other than `offset` describe
+// the grasp's own correction (the outer hand's is `offset` composed before it).
 typedef struct XrGraspHandOffsetSDFG {
   XrStructureType type;  // XR_TYPE_GRASP_HAND_OFFSET_SDFG
   void* XR_MAY_ALIAS next;
@@ -516,12 +519,12 @@ typedef XrResult(XRAPI_PTR* PFN_xrGetGraspTargetStateSDFG)(XrGraspTargetSDFG tar
 //      close past it onto the table);
 //   2. between those, the one whose surface is nearest the palm joint's centre (exact distance);
 //   3. between those, the one created first.
-// A target the hand does not touch is never taken (one behind another, say). While the fingers touch only targets the hand may
-// not take (a table, a wall, a target of the other hand), the hand holds nothing: its fingers
-// rest on what they touch (xrLocateHandJointsEXT shows them closed there; XrGraspTouchesSDFG
-// says on what), isGrasping stays XR_FALSE, and the first solve whose fingers touch a graspable
-// target takes it. A grasp keeps its target until it ends. Up to version 2 the rule was the
-// target whose bounds' centre was nearest the grab box's centre.
+// A target the hand does not touch is never taken (one behind another, say). While the fingers
+// touch only targets the hand may not take (a table, a wall, a target of the other hand), the hand
+// holds nothing: its fingers rest on what they touch (xrLocateHandJointsEXT shows them closed
+// there; XrGraspTouchesSDFG says on what), isGrasping stays XR_FALSE, and the first solve whose
+// fingers touch a graspable target takes it. A grasp keeps its target until it ends. Up to version
+// 2 the rule was the target whose bounds' centre was nearest the grab box's centre.
 //
 // Every version 1 and 2 struct keeps its layout, and their apps run unchanged: their targets are
 // GRASPABLE, and a target they made not graspable by a hand (graspableBy) now stops that hand's
@@ -578,6 +581,26 @@ typedef struct XrGraspTargetShapeSDFG {
   // (0, 1000]; PLANE: (0, 0, 0). Anything else: XR_ERROR_VALIDATION_FAILURE.
   XrVector3f halfExtents;
 } XrGraspTargetShapeSDFG;
+
+// Optional input, chained on XrGraspOptionsSDFG::next: the outer hand. In every frame, squeezed or
+// not, the hand xrLocateHandJointsEXT returns stays outside every target near it (role GRASPABLE
+// or SCENE; IGNORED targets and targets in the app's Vulkan buffers are not seen): a tracked hand
+// that enters a target is shown stopped on its surface, sliding along it, found from where it was
+// shown last so it never crosses a thin part; a finger pressed onto a surface stops on it; a held
+// target counts as part of the hand (kept out of the others). While the tracked hand is clear of
+// everything the shown hand is the tracked hand exactly, and while no target is near the joints
+// pass through bit-identical. When the tracked hand is more than releaseDistance from the shown
+// one, the shown hand returns to tracking over blendTime and holds again once the tracked hand is
+// clear. The whole-hand offset is reported in every frame by XrGraspHandOffsetSDFG::offset.
+// On by default (the layer configuration's outer_hand); docs/layer.md says why. Applied from the
+// next xrSyncActions. A zero field keeps the layer's default.
+typedef struct XrGraspOuterHandOptionsSDFG {
+  XrStructureType type;  // XR_TYPE_GRASP_OUTER_HAND_OPTIONS_SDFG
+  const void* XR_MAY_ALIAS next;
+  XrGraspSwitchSDFG outerHand;  // keep the shown hand out of the targets in every frame
+  float releaseDistance;        // metres, 0 or (0, 1]: the shown hand returns to tracking past it
+  float blendTime;              // seconds, 0 or (0, 2]: how long that return takes
+} XrGraspOuterHandOptionsSDFG;
 
 // Optional output, chained on XrGraspStateSDFG::next: what the hand's fingers touch, held or not.
 typedef struct XrGraspTouchesSDFG {

@@ -42,6 +42,7 @@ std::optional<Error> GraspSettings::validate() const {
     return makeError(Status::invalid_argument, "grasp settings: tolerances must be >= 0");
   if (buildTimeLimit.count() <= 0)
     return makeError(Status::invalid_argument, "grasp settings: buildTimeLimit must be positive");
+  if (auto e = outerOptions.validate()) return e;
   return std::nullopt;
 }
 
@@ -584,17 +585,38 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
   return update(side, frame, std::span<const SpaceFrame>(spaces));
 }
 
-Status GraspSession::update(Hand side, const HandFrame& frame, std::span<const SpaceFrame> spaces) {
+Status GraspSession::update(Hand side, const HandFrame& tracked,
+                            std::span<const SpaceFrame> spaces) {
   index_.setSpaces(spaces);
   const size_t slot = size_t(side);
   HandState& hand = hands_[slot];
-  hand.squeeze = std::isfinite(frame.squeeze) ? frame.squeeze : 0.0f;
-  hand.frameTime = frame.time;
+  hand.squeeze = std::isfinite(tracked.squeeze) ? tracked.squeeze : 0.0f;
+  hand.frameTime = tracked.time;
   refreshSetups();
-  Status collected = collectJob(hand, slot);
+  const Status jobStatus = collectJob(hand, slot);
+  Status collected = jobStatus == Status::ok ? collect(hand, slot) : jobStatus;
+  // A grasp that ends this frame ends before the outer hand looks: the object let go is scene
+  // again at once, and one taken this frame is part of the hand at once.
+  bool released = false;
+  if (jobStatus == Status::ok && !hand.waitForRelease && hand.grasp.holding) {
+    const uint64_t held = hand.grasp.target;
+    bool keep = hand.squeeze >= settings_.grabThreshold * settings_.releaseRatio;
+    if (held != 0) {
+      auto it = targets_.find(held);
+      keep = keep && it != targets_.end() && it->second.hands[slot] &&
+             it->second.role == TargetRole::graspable;
+    }
+    if (!keep) {
+      cancelPending(hand, slot);
+      hand.grasp = HandGrasp{};
+      released = true;
+    }
+  }
+  // From here on the hand is where it is shown: kept out of the scene by the outer hand.
+  JointPoses moved;
+  const HandFrame frame = updateOuter(side, hand, tracked, moved);
   // A failed job left the hand open: it stays so for this frame (the caller logs why).
-  if (collected != Status::ok) return collected;
-  collected = collect(hand, slot);
+  if (jobStatus != Status::ok || released) return collected;
   if (hand.waitForRelease) {
     if (hand.squeeze >= settings_.grabThreshold * settings_.releaseRatio) return collected;
     hand.waitForRelease = false;
@@ -606,17 +628,6 @@ Status GraspSession::update(Hand side, const HandFrame& frame, std::span<const S
   }
   if (hand.grasp.holding) {
     const uint64_t held = hand.grasp.target;
-    bool keep = hand.squeeze >= settings_.grabThreshold * settings_.releaseRatio;
-    if (held != 0) {
-      auto it = targets_.find(held);
-      keep = keep && it != targets_.end() && it->second.hands[slot] &&
-             it->second.role == TargetRole::graspable;
-    }
-    if (!keep) {
-      cancelPending(hand, slot);
-      hand.grasp = HandGrasp{};
-      return collected;
-    }
     if (!frame.valid) return collected;  // keep the last solve
     std::vector<GraspWorker::JobMember> members = sceneInBox(side, frame.worldFromWrist, held);
     if (held != 0) {

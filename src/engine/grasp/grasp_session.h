@@ -18,6 +18,12 @@
 // closed, the grasp is solved again when anything in the box moves relative to the hand, comes or
 // goes, or changes its vertices.
 //
+// The outer hand (settings.outerHand): in every frame, whether the user squeezes or not, each
+// hand near a target is kept outside every target near it (grasp/outer_hand.h, run on the
+// worker; grasp/outer_view.h says how a frame is drawn before its result is in). The grab logic
+// then works with the hand where it is shown: a grab starts from the outer hand, not from inside
+// the table, and a held target counts as part of the hand (it is kept out of the rest).
+//
 // Threading: a GraspWorker owned by the session runs the target set-up (addTarget returns at
 // once; the target is graspable once targetSetup() says ready), the refit after new vertices, the
 // CPU builds and every solve with its exact check; update() only hands the frame's poses over and
@@ -53,6 +59,8 @@
 #include "grasp/contact.h"
 #include "grasp/grasp_worker.h"
 #include "grasp/hand_clearance.h"
+#include "grasp/outer_hand.h"
+#include "grasp/outer_view.h"
 #include "grasp/solver.h"
 #include "hand/hand_model.h"
 #include "mesh/mesh.h"
@@ -83,6 +91,11 @@ struct GraspSettings {
   // a device build that never completes. CPU builds on the worker stop at it; a deferred (GPU)
   // build still not collected after it is cancelled. Positive.
   std::chrono::milliseconds buildTimeLimit{1000};
+  // The outer hand: the shown hand stays outside every target near it in every frame. Off in
+  // the engine (its tools and tests compare solvers on the hand as given); the layer turns it on
+  // for apps (docs/layer.md says why). Takes effect at the next update.
+  bool outerHand = false;
+  OuterHandOptions outerOptions{};
 
   std::optional<Error> validate() const;
 };
@@ -253,6 +266,8 @@ class GraspSession {
   std::optional<Pose> reposeCorrection(Hand hand) const;
   // The model the hand's grasp was solved with (default adult until a tracked grab fits one).
   const HandModel& model(Hand hand) const { return hands_[size_t(hand)].model; }
+  // What the outer hand shows of the hand as of the last update (inactive: the hand as given).
+  const OuterView& outerView(Hand hand) const { return hands_[size_t(hand)].outer.view; }
   float lastSqueeze(Hand hand) const { return hands_[size_t(hand)].squeeze; }
 
  private:
@@ -315,7 +330,22 @@ class GraspSession {
     bool decided = false;
     // The deferred build's scene (members[0] is the target it builds).
     std::vector<GraspWorker::JobMember> pendingMembers;
+    struct Outer {
+      bool engaged = false;      // jobs posted since the last reset
+      uint64_t ticket = 0;       // of the last job posted
+      uint64_t resetTicket = 0;  // results up to this ticket predate the last reset
+      OuterView view;
+    } outer;
   };
+  // The outer hand's part of an update (grasp_session_outer.cpp): takes its newest result,
+  // decides the frame's fallback, posts the frame's job, and returns the hand where it is shown
+  // (`frame` moved by the fallback; its tracked joints copied to `moved`).
+  HandFrame updateOuter(Hand side, HandState& hand, const HandFrame& frame, JointPoses& moved);
+  // The placed, set-up targets with a CPU mesh or shape whose bounds overlap the box of half
+  // extents `half` centred on `centre` (world), as outer-hand members (objectFromHand maps world
+  // points), the held target left out.
+  void outerMembers(const glm::vec3& centre, float half, uint64_t held,
+                    std::vector<GraspWorker::JobMember>& out) const;
   // Sets hand.trackedParts from the frame's tracked joints (none: count 0). Before a solve.
   static void noteTrackedParts(HandState& hand, const HandFrame& frame);
 

@@ -166,9 +166,7 @@ std::optional<GraspWorker::Done> GraspWorker::take(size_t slot) {
 
 bool GraspWorker::waitIdle(std::chrono::milliseconds timeout) const {
   std::unique_lock lock(mutex_);
-  return idle_.wait_for(lock, timeout, [&] {
-    return !busy_ && setups_.empty() && !slots_[0].queued && !slots_[1].queued;
-  });
+  return idle_.wait_for(lock, timeout, [&] { return !busy_ && !anyQueued(); });
 }
 
 uint64_t GraspWorker::setupsDone() const {
@@ -231,8 +229,7 @@ void GraspWorker::run() {
 #endif
   std::unique_lock lock(mutex_);
   for (;;) {
-    wake_.wait(lock,
-               [&] { return stop_ || !setups_.empty() || slots_[0].queued || slots_[1].queued; });
+    wake_.wait(lock, [&] { return stop_ || anyQueued(); });
     if (stop_) break;
     busy_ = true;
     if (!setups_.empty()) {
@@ -241,20 +238,142 @@ void GraspWorker::run() {
       setups_.pop_front();
       auto it = targets_.find(id);
       if (it != targets_.end() && it->second->setupMesh) runSetup(lock, id, it->second);
+    } else if ((outer_[0].queued || outer_[1].queued) &&
+               !(lastRanOuter_ && (slots_[0].queued || slots_[1].queued))) {
+      // The outer hand next: one frame's short solve, which the hand shows at once, before a
+      // build of a grab (milliseconds) that the hand waits frames for anyway. Outer jobs come
+      // every frame: after one, a queued grab runs before the next, so a worker slower than the
+      // frames cannot starve the grab.
+      size_t slot = nextOuter_;
+      if (!outer_[slot].queued) slot = 1 - slot;
+      nextOuter_ = 1 - slot;
+      lastRanOuter_ = true;
+      OuterJob job = std::move(*outer_[slot].queued);
+      outer_[slot].queued.reset();
+      runOuter(lock, slot, std::move(job));
     } else {
       // The slots take turns, so one hand's stream of re-solves cannot starve the other's grab.
       size_t slot = nextSlot_;
       if (!slots_[slot].queued) slot = 1 - slot;
       nextSlot_ = 1 - slot;
+      lastRanOuter_ = false;
       Job job = std::move(*slots_[slot].queued);
       slots_[slot].queued.reset();
       runJob(lock, slot, std::move(job));
     }
     busy_ = false;
-    if (setups_.empty() && !slots_[0].queued && !slots_[1].queued) idle_.notify_all();
+    if (!anyQueued()) idle_.notify_all();
   }
   busy_ = false;
   idle_.notify_all();
+}
+
+bool GraspWorker::anyQueued() const {
+  return !setups_.empty() || slots_[0].queued || slots_[1].queued || outer_[0].queued ||
+         outer_[1].queued;
+}
+
+void GraspWorker::requestOuter(size_t slot, OuterJob job) {
+  {
+    std::lock_guard lock(mutex_);
+    outer_[slot].queued = std::move(job);
+  }
+  wake_.notify_all();
+}
+
+void GraspWorker::resetOuter(size_t slot) {
+  std::lock_guard lock(mutex_);
+  outer_[slot].queued.reset();
+  outer_[slot].reset = true;
+}
+
+void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, OuterJob job) {
+  OuterSlot& o = outer_[slot];
+  const bool reset = o.reset;
+  o.reset = false;
+  // The members as the exact source sees them (meshes and shapes; device targets have no CPU
+  // mesh and are not kept out), looked up under the lock and read outside it: only this thread
+  // touches a target's distance structure.
+  std::vector<std::shared_ptr<Target>> keep;
+  std::vector<SceneMember> scene;
+  for (const JobMember& m : job.members) {
+    if (m.target == job.attached) continue;
+    auto it = targets_.find(m.target);
+    if (it == targets_.end() || it->second->setup != TargetSetup::ready) continue;
+    const Target& t = *it->second;
+    if (t.distance == nullptr && !t.shape) continue;
+    keep.push_back(it->second);
+    SceneMember sm;
+    sm.id = m.target;
+    sm.mesh = t.distance.get();
+    sm.shape = t.shape ? &*t.shape : nullptr;
+    sm.objectFromHand = m.objectFromHand;
+    scene.push_back(sm);
+    if (scene.size() == kMaxSceneMembers) break;
+  }
+  std::shared_ptr<Target> attached;
+  uint64_t attachedVersion = 0;
+  if (job.attached != 0) {
+    auto it = targets_.find(job.attached);
+    if (it != targets_.end() && it->second->setup == TargetSetup::ready) {
+      attached = it->second;
+      attachedVersion = attached->appliedVersion;
+    }
+  }
+  lock.unlock();
+  auto done = std::make_shared<OuterDone>();
+  done->ticket = job.ticket;
+  done->trackedWrist = job.worldFromWrist;
+  for (int j = 0; j < kJointCount; ++j) {
+    done->trackedJoints[size_t(j)] =
+        job.worldFromWrist.transformPoint(job.joints[size_t(j)].position);
+    done->radii[size_t(j)] = job.radii[size_t(j)];
+  }
+  try {
+    if (reset && o.hand != nullptr) o.hand->reset();
+    if (o.hand == nullptr)
+      o.hand = std::make_unique<OuterHand>(job.model, job.options);
+    else
+      o.hand->setModel(job.model);
+    o.hand->setOptions(job.options);
+    // The held object's surface, sampled once per target and shape.
+    std::vector<HandPart> parts;
+    if (attached != nullptr) {
+      if (o.sampledTarget != job.attached || o.sampledVersion != attachedVersion) {
+        o.samples = attached->shape                 ? surfaceParts(*attached->shape)
+                    : attached->distance != nullptr ? surfaceParts(attached->distance->mesh())
+                                                    : std::vector<HandPart>{};
+        o.sampledTarget = job.attached;
+        o.sampledVersion = attachedVersion;
+      }
+      parts.reserve(o.samples.size());
+      for (HandPart p : o.samples) {
+        p.centre = job.wristFromAttached.transformPoint(p.centre);
+        done->attachedReach = std::max(done->attachedReach, glm::length(p.centre));
+        parts.push_back(p);
+      }
+    }
+    OuterHandInput in;
+    in.worldFromWrist = job.worldFromWrist;
+    in.joints = &job.joints;
+    in.radii = &job.radii;
+    in.time = job.time;
+    in.attached = parts;
+    const SceneExactSource source(scene);
+    auto r = o.hand->update(in, scene.empty() ? nullptr : &source);
+    if (r)
+      done->result = *r;
+    else
+      done->status = r.error().code;
+  } catch (const std::bad_alloc&) {
+    done->status = Status::out_of_memory;
+  } catch (...) {
+    done->status = Status::internal;
+  }
+  keep.clear();
+  attached.reset();
+  o.mailbox->latest.store(std::move(done));
+  lock.lock();
 }
 
 void GraspWorker::keepSpares(Target& target, std::vector<std::vector<glm::vec3>>& buffers) {

@@ -44,6 +44,7 @@
 #include "base/status.h"
 #include "grasp/contact.h"
 #include "grasp/hand_clearance.h"
+#include "grasp/outer_hand.h"
 #include "grasp/solver.h"
 #include "hand/hand_model.h"
 #include "mesh/mesh.h"
@@ -147,6 +148,43 @@ class GraspWorker {
     std::chrono::microseconds duration{0};
   };
 
+  // One hand's outer hand for one frame (grasp/outer_hand.h): where the hand is shown so that it
+  // stays outside every target near it. Short (a few hundred exact samples): the worker runs it
+  // before any queued build, and a newer one replaces one not yet started.
+  struct OuterJob {
+    uint64_t ticket = 0;  // increasing per slot; echoed in OuterDone
+    // The targets near the hand; JobMember::objectFromHand maps *world* points here (the
+    // session's common space), not the hand's.
+    std::vector<JobMember> members;
+    Pose worldFromWrist;  // the tracked (or synthesized) wrist
+    JointPoses joints{};  // the hand as it would be shown, wrist frame
+    std::array<float, kJointCount> radii{};
+    double time = 0.0;  // seconds
+    // A held object: part of the hand (kept out of everything else, not out of itself). Its
+    // surface is sampled here, once per target and vertex version.
+    uint64_t attached = 0;
+    Pose wristFromAttached;
+    HandModel model = HandModel::defaultAdult(Hand::right);
+    OuterHandOptions options{};
+  };
+  struct OuterDone {
+    uint64_t ticket = 0;
+    Status status = Status::ok;
+    OuterHandResult result{};
+    Pose trackedWrist;  // OuterJob::worldFromWrist: what the result's shown pose was solved for
+    // The job's joints placed at the tracked wrist (world), and the attached parts' farthest
+    // reach from the wrist: how far the tracked hand moved since (GraspSession's fast path).
+    std::array<glm::vec3, kJointCount> trackedJoints{};
+    std::array<float, kJointCount> radii{};
+    float attachedReach = 0.0f;
+  };
+  // The newest finished outer-hand result of a slot, published by the worker and read without a
+  // lock from any thread (the layer's xrLocateHandJointsEXT draws with a result that finished
+  // after the update that asked for it).
+  struct OuterMailbox {
+    std::atomic<std::shared_ptr<const OuterDone>> latest;
+  };
+
   // `backend`: the CPU grab-box builder the worker uses (one thread is the session's default:
   // the worker must not starve an app on a 2-core machine).
   explicit GraspWorker(std::unique_ptr<SdfBackend> backend);
@@ -182,6 +220,17 @@ class GraspWorker {
   // busy at that instant: poll again).
   std::optional<Done> take(size_t slot);
 
+  // Leaves the outer-hand job of `slot` (replacing one not yet started).
+  void requestOuter(size_t slot, OuterJob job);
+  // Where the slot's outer-hand results are published (the same mailbox for the worker's life).
+  std::shared_ptr<const OuterMailbox> outerMailbox(size_t slot) const {
+    return outer_[slot].mailbox;
+  }
+  // Forgets the slot's outer-hand history (the hand left every target): the next job starts from
+  // its tracked pose. Drops a queued job; a result of an older ticket may still be published, the
+  // owner ignores it.
+  void resetOuter(size_t slot);
+
   // Waits until nothing is queued or running, at most `timeout`; false on timeout. For tests and
   // tools: the layer never waits for the worker.
   bool waitIdle(std::chrono::milliseconds timeout) const;
@@ -211,6 +260,16 @@ class GraspWorker {
     std::shared_ptr<const std::vector<uint32_t>> orientedIndices;
     bool lastUpdateRefused = false;  // worker thread only: reports a run of refusals once
   };
+  struct OuterSlot {
+    std::optional<OuterJob> queued;
+    bool reset = false;  // drop the history before the next job
+    std::shared_ptr<OuterMailbox> mailbox = std::make_shared<OuterMailbox>();
+    // Worker thread only: the history, and the held object's surface samples (object frame).
+    std::unique_ptr<OuterHand> hand;
+    uint64_t sampledTarget = 0;
+    uint64_t sampledVersion = 0;
+    std::vector<HandPart> samples;
+  };
   struct Slot {
     std::optional<Job> queued;
     bool running = false;
@@ -230,6 +289,9 @@ class GraspWorker {
   void run();
   void runSetup(std::unique_lock<std::mutex>& lock, uint64_t id, std::shared_ptr<Target> target);
   void runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job job);
+  void runOuter(std::unique_lock<std::mutex>& lock, size_t slot, OuterJob job);
+  // Anything queued (the caller holds the mutex).
+  bool anyQueued() const;
   // After the solve: which target the hand takes, what each finger touches, and the contacts on
   // the target taken (Done::chosen, touched, contacts, objectFromHand, version).
   static void chooseAndContact(const Job& job, std::span<const SceneMember> scene,
@@ -270,7 +332,10 @@ class GraspWorker {
   std::map<uint64_t, std::shared_ptr<Target>> targets_;
   std::deque<uint64_t> setups_;
   std::array<Slot, kSlots> slots_;
+  std::array<OuterSlot, kSlots> outer_;
   size_t nextSlot_ = 0;
+  size_t nextOuter_ = 0;       // the outer slots take turns too
+  bool lastRanOuter_ = false;  // a queued grab runs before the next outer job
   bool busy_ = false;
   uint64_t setupsDone_ = 0;
   uint64_t jobsDone_ = 0;

@@ -33,6 +33,8 @@
 #include "grasp/hand_clearance.h"
 #include "grasp/solver.h"
 #include "hand/hand_model.h"
+#include "mesh/mesh.h"
+#include "scene/analytic_shape.h"
 
 namespace sdfg {
 
@@ -70,9 +72,21 @@ struct OuterHandResult {
   bool touching = false;     // some part is on a surface (within margin + 0.5 mm)
   bool blending = false;     // returning to tracking past releaseDistance
   bool released = false;     // following tracking until the tracked hand is clear again
-  float clearance = 0.0f;    // smallest part clearance of the shown hand, metres (inf: nothing)
-  int samples = 0;           // exact samples taken this frame
+  // A lower bound of the shown hand's smallest part clearance, metres (inf: nothing near; for a
+  // free hand searched to 2.5 cm, so at most that).
+  float clearance = 0.0f;
+  int samples = 0;  // exact samples taken this frame
 };
+
+// Points on a held object's surface (object frame, radius 0), for OuterHandInput::attached once
+// moved to the wrist frame: its vertices, evenly thinned, and points spread over its triangles by
+// area, at most kMaxAttachedParts in all. Between samples an edge of the scene can dent the
+// object by the samples' spacing (millimetres on a hand-sized object); the hand's own parts are
+// covered exactly.
+inline constexpr int kMaxAttachedParts = 256;
+std::vector<HandPart> surfaceParts(const TriangleMesh& mesh);
+// A box's corners, edge midpoints and a grid on each face; nothing for a plane (never held).
+std::vector<HandPart> surfaceParts(const AnalyticShape& shape);
 
 class OuterHand {
  public:
@@ -83,8 +97,10 @@ class OuterHand {
   // non-finite poses).
   Result<OuterHandResult> update(const OuterHandInput& in, const ExactDistanceSource* scene);
   void reset();
-  // The hand model whose curls the capped fingers use (fitted to a tracked hand by the caller).
+  // The hand model whose curls the capped fingers use (fitted to a tracked hand by the caller);
+  // the same model again changes nothing.
   void setModel(const HandModel& model);
+  void setOptions(const OuterHandOptions& options) { options_ = options; }
   const HandModel& model() const { return model_; }
 
  private:

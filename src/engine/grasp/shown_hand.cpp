@@ -15,21 +15,34 @@ ShownHand takeShownHand(const GraspSession& session, Hand hand, const HandOffset
   v.offsetShown = offset.blend > 0.0f;
   v.offset = shownHandOffset(offset);
   v.squeeze = squeeze;
+  v.outer = session.outerView(hand);
   return v;
+}
+
+Pose shownWholeOffset(const ShownHand& view) {
+  const OuterNow outer = resolveOuter(view.outer);
+  Pose offset = outer.changes ? outer.offset : Pose{};
+  if (view.offsetShown) offset = offset * view.offset;
+  return offset;
 }
 
 void drawTrackedHand(const ShownHand& view, JointPoses& joints,
                      std::array<bool, kJointCount>& changed) {
   changed.fill(false);
   if (!view.changesHand()) return;
+  const OuterNow outer = resolveOuter(view.outer);
+  if (!view.shown && !view.offsetShown && !view.repose && !outer.changes) return;
   const Pose wristFromBase = joints[size_t(Joint::wrist)].inverse();
   JointPoses local;
   for (int j = 0; j < kJointCount; ++j) local[size_t(j)] = wristFromBase * joints[size_t(j)];
   Pose baseFromWrist = joints[size_t(Joint::wrist)];
   bool whole = view.offsetShown;
-  if (view.repose) {
-    // A re-solve is on its way: the whole hand follows the target since the shown solve.
-    baseFromWrist = baseFromWrist * *view.repose;
+  // The outer hand first: the whole hand where it is kept out of the scene; the grasp was solved
+  // on the hand there.
+  if (outer.changes) baseFromWrist = baseFromWrist * outer.offset;
+  // A re-solve is on its way: the whole hand follows the target since the shown solve.
+  if (view.repose) baseFromWrist = baseFromWrist * *view.repose;
+  if (outer.changes || view.repose) {
     for (int j = 0; j < kJointCount; ++j) joints[size_t(j)] = baseFromWrist * local[size_t(j)];
     whole = true;
   }
@@ -41,6 +54,7 @@ void drawTrackedHand(const ShownHand& view, JointPoses& joints,
       for (Joint j : fingerJoints(static_cast<Finger>(f))) changed[size_t(j)] = true;
     }
   }
+  if (outer.changes) capFingers(view.outer.model, outer, baseFromWrist, joints);
   // The whole hand moves out of the object, every joint (wrist and palm too).
   if (view.offsetShown) applyHandOffset(view.offset, joints);
   if (whole) changed.fill(true);
@@ -48,7 +62,9 @@ void drawTrackedHand(const ShownHand& view, JointPoses& joints,
 
 void drawGripHand(const ShownHand& view, const Pose& baseFromGrip, MotionRange range,
                   JointPoses& joints, JointRadii& radii) {
+  const OuterNow outer = resolveOuter(view.outer);
   Pose baseFromWrist = baseFromGrip * wristFromGrip(view.model).inverse();
+  if (outer.changes) baseFromWrist = baseFromWrist * outer.offset;
   // A re-solve is on its way: the hand follows the target since the shown solve, so its contacts
   // stay on the surface (docs/threading.md).
   if (view.repose) baseFromWrist = baseFromWrist * *view.repose;
@@ -58,6 +74,7 @@ void drawGripHand(const ShownHand& view, const Pose& baseFromGrip, MotionRange r
     const ShownCurls c = shownCurls(view.result, user);
     replaceFingers(view.model, c.curls, c.replace, baseFromWrist, joints);
   }
+  if (outer.changes) capFingers(view.outer.model, outer, baseFromWrist, joints);
   if (view.offsetShown) applyHandOffset(view.offset, joints);
 }
 

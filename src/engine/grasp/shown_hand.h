@@ -13,6 +13,7 @@
 #include "base/pose.h"
 #include "grasp/grasp_session.h"
 #include "grasp/hand_offset_blend.h"
+#include "grasp/outer_view.h"
 #include "hand/hand_model.h"
 #include "hand/hand_synthesis.h"
 
@@ -28,9 +29,16 @@ struct ShownHand {
   Pose offset;               // shownHandOffset(): the whole hand moves by it (wrist frame)
   bool offsetShown = false;  // blend > 0
   float squeeze = 0.0f;      // the grab input at the update: a synthesized hand's curl
-  // Whether drawing changes a tracked hand at all (if not, its joints pass through untouched).
-  bool changesHand() const { return shown || offsetShown; }
+  // The outer hand (grasp/outer_view.h): applied first, the grasp drawn on the hand it shows.
+  OuterView outer;
+  // Whether drawing may change a tracked hand at all (if not, its joints pass through untouched;
+  // an active outer hand that finds the hand clear leaves them untouched too).
+  bool changesHand() const { return shown || offsetShown || outer.active; }
 };
+
+// The whole hand's offset drawn now, in the tracked wrist's frame: the outer hand's, then the
+// grasp's (XrGraspHandOffsetSDFG::offset).
+Pose shownWholeOffset(const ShownHand& view);
 
 // The snapshot of `hand` after `session`'s update, with the hand's offset and squeeze.
 ShownHand takeShownHand(const GraspSession& session, Hand hand, const HandOffset& offset,

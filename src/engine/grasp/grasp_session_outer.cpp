@@ -1,0 +1,170 @@
+// GraspSession's outer hand: per update, what the frame shows until the worker's result for it is
+// in, and the frame's job for the worker (grasp/outer_view.h says how the two meet).
+#include <algorithm>
+#include <cmath>
+
+#include "grasp/grasp_session.h"
+#include "grasp/shown_curls.h"
+#include "hand/hand_synthesis.h"
+
+namespace sdfg {
+namespace {
+
+// Targets whose bounds come within this of the palm (either the tracked or the last shown one)
+// are kept out: a hand reaches about 0.2 m from its palm, and moves 2.2 cm in a frame at 2 m/s.
+constexpr float kOuterReach = 0.15f;  // metres, half the box's edge
+
+float angleOf(const glm::quat& q) {
+  return 2.0f * std::acos(std::min(1.0f, std::abs(q.w)));
+}
+
+}  // namespace
+
+void GraspSession::outerMembers(const glm::vec3& centre, float half, uint64_t held,
+                                std::vector<GraspWorker::JobMember>& out) const {
+  std::vector<SceneHit> hits;
+  index_.query(Pose{glm::quat(1, 0, 0, 0), centre}, glm::vec3(half), hits);
+  for (const SceneHit& h : hits) {
+    if (h.target == held) continue;
+    if (std::any_of(out.begin(), out.end(),
+                    [&](const GraspWorker::JobMember& m) { return m.target == h.target; }))
+      continue;
+    auto it = targets_.find(h.target);
+    if (it == targets_.end() || it->second.setup != TargetSetup::ready ||
+        it->second.role == TargetRole::ignored)
+      continue;
+    // Device targets have no CPU distance: the outer hand cannot see them.
+    if (!it->second.meshTarget && !it->second.shapeTarget) continue;
+    GraspWorker::JobMember m;
+    m.target = h.target;
+    m.objectFromHand = h.worldFromObject.inverse();  // maps world points (OuterJob::members)
+    out.push_back(m);
+  }
+}
+
+HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame& frame,
+                                    JointPoses& moved) {
+  const size_t slot = size_t(side);
+  HandState::Outer& outer = hand.outer;
+  auto stop = [&] {
+    if (outer.engaged) {
+      worker_->resetOuter(slot);
+      outer.resetTicket = outer.ticket;
+      outer.engaged = false;
+    }
+    outer.view.active = false;
+    outer.view.changes = false;
+    return frame;
+  };
+  if (!settings_.outerHand || !frame.valid) return stop();
+
+  // The hand as it would be shown without the outer hand, wrist frame: tracked joints, or the
+  // model closed by the squeeze; with a shown grasp's fingers on what they hold.
+  JointPoses local;
+  JointRadii radii;
+  const bool tracked = frame.trackedJoints != nullptr && frame.trackedRadii != nullptr;
+  if (tracked) {
+    const Pose wristFromWorld = frame.worldFromWrist.inverse();
+    for (int j = 0; j < kJointCount; ++j)
+      local[size_t(j)] = wristFromWorld * (*frame.trackedJoints)[size_t(j)];
+    radii = *frame.trackedRadii;
+  } else {
+    placeJoints(hand.model, curlsFromSqueeze(hand.squeeze, MotionRange::unobstructed), Pose{},
+                local, radii);
+  }
+  JointPoses shown = local;
+  if (hand.grasp.shown()) {
+    const ShownCurls c = shownCurls(hand.grasp.result, hand.model.estimateCurls(local));
+    replaceFingers(hand.model, c.curls, c.replace, Pose{}, shown);
+  }
+
+  // What is near: around the tracked palm and the last shown one.
+  const uint64_t held = hand.grasp.holdsTarget() ? hand.grasp.target : 0;
+  const glm::vec3 palm = local[size_t(Joint::palm)].position;
+  std::vector<GraspWorker::JobMember> members;
+  outerMembers(frame.worldFromWrist.transformPoint(palm), kOuterReach, held, members);
+  const std::shared_ptr<const GraspWorker::OuterDone> latest =
+      outer.engaged ? worker_->outerMailbox(slot)->latest.load() : nullptr;
+  const bool fresh =
+      latest != nullptr && latest->ticket > outer.resetTicket && latest->status == Status::ok;
+  if (fresh)
+    outerMembers(latest->result.worldFromShownWrist.transformPoint(palm), kOuterReach, held,
+                 members);
+  if (members.empty()) return stop();
+
+  if (!outer.engaged) {
+    // A tracked hand brings its own bones: the capped fingers take its shape.
+    outer.view.model = hand.model;
+    if (tracked) {
+      if (auto fitted = HandModel::fitToJoints(side, *frame.trackedJoints, *frame.trackedRadii))
+        outer.view.model = std::move(*fitted);
+    }
+  }
+
+  // The fallback: the tracked hand when the last result was clear by more than any part moved
+  // since, else the hand where the last result showed it.
+  OuterView& view = outer.view;
+  view.active = true;
+  view.changes = false;
+  view.offset = Pose{};
+  view.capped.fill(false);
+  view.curl.fill(0.0f);
+  if (fresh) {
+    const OuterHandResult& r = latest->result;
+    bool clear = !r.constrained;
+    if (clear) {
+      float motion = 0.0f;
+      for (int j = 0; j < kJointCount; ++j) {
+        const glm::vec3 now = frame.worldFromWrist.transformPoint(shown[size_t(j)].position);
+        motion = std::max(motion, glm::length(now - latest->trackedJoints[size_t(j)]) +
+                                      std::max(0.0f, radii[size_t(j)] - latest->radii[size_t(j)]));
+      }
+      if (held != 0) {
+        const Pose turn = latest->trackedWrist.inverse() * frame.worldFromWrist;
+        motion = std::max(
+            motion, glm::length(frame.worldFromWrist.position - latest->trackedWrist.position) +
+                        angleOf(turn.orientation) * latest->attachedReach);
+      }
+      clear = motion + settings_.outerOptions.margin < r.clearance;
+    }
+    if (!clear) {
+      view.offset = frame.worldFromWrist.inverse() * r.worldFromShownWrist;
+      view.capped = r.capped;
+      view.curl = r.curl;
+      view.changes = true;
+    }
+  }
+
+  GraspWorker::OuterJob job;
+  job.ticket = ++outer.ticket;
+  job.members = std::move(members);
+  job.worldFromWrist = frame.worldFromWrist;
+  job.joints = shown;
+  job.radii = radii;
+  job.time = double(frame.time) * 1e-9;
+  job.model = view.model;
+  job.options = settings_.outerOptions;
+  const Pose worldFromShown = frame.worldFromWrist * view.offset;
+  if (held != 0) {
+    if (auto at = index_.worldFromObject(held)) {
+      job.attached = held;
+      // Held where the shown hand holds it (the app carries it with the hand it draws).
+      job.wristFromAttached = worldFromShown.inverse() * *at;
+    }
+  }
+  worker_->requestOuter(slot, std::move(job));
+  outer.engaged = true;
+  view.ticket = outer.ticket;
+  view.mailbox = worker_->outerMailbox(slot);
+
+  if (!view.changes) return frame;
+  HandFrame out = frame;
+  out.worldFromWrist = worldFromShown;
+  if (tracked) {
+    for (int j = 0; j < kJointCount; ++j) moved[size_t(j)] = worldFromShown * local[size_t(j)];
+    out.trackedJoints = &moved;
+  }
+  return out;
+}
+
+}  // namespace sdfg

@@ -1,0 +1,53 @@
+// What the outer hand (grasp/outer_hand.h) shows of one hand as of one grab update, and the
+// correction to draw at the instant a hand is drawn.
+//
+// The outer hand runs on the session's worker, so an update cannot wait for it. Each update
+// posts the frame's job and decides a fallback from the newest result it has (of an earlier
+// frame): the tracked hand itself when that result was clear by more than the hand moved since
+// (it is clear now too), else the hand held where that result showed it (clear, one frame
+// behind). The app draws later in its frame, usually after the worker finished the update's own
+// job: resolveOuter() then draws that result instead, on time. Reading the result takes no lock.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+
+#include "base/pose.h"
+#include "grasp/grasp_worker.h"
+#include "hand/hand_model.h"
+
+namespace sdfg {
+
+struct OuterView {
+  // The outer hand runs for this hand (a target is near it). False: the tracked hand, exactly.
+  bool active = false;
+  uint64_t ticket = 0;  // the job the update posted; its result replaces the fallback
+  std::shared_ptr<const GraspWorker::OuterMailbox> mailbox;
+  // The fallback: the shown wrist in the tracked wrist's frame, and per finger whether it is shown
+  // at the model's pose at curl[f] instead of as given.
+  Pose offset;
+  std::array<bool, kFingerCount> capped{};
+  std::array<float, kFingerCount> curl{};
+  bool changes = false;  // the fallback differs from the tracked hand
+  HandModel model = HandModel::defaultAdult(Hand::right);  // whose curls capped fingers take
+};
+
+// The correction to draw now.
+struct OuterNow {
+  bool changes = false;  // false: draw the hand as given
+  Pose offset;           // the shown wrist in the tracked wrist's frame
+  std::array<bool, kFingerCount> capped{};
+  std::array<float, kFingerCount> curl{};
+  bool onTime = false;  // from the update's own job (not the fallback)
+};
+
+// The update's own result when the worker has published it, else the fallback.
+OuterNow resolveOuter(const OuterView& view);
+
+// Replaces the joints (any base space, wrist at baseFromWrist) of each capped finger by the
+// model's pose at its curl.
+void capFingers(const HandModel& model, const OuterNow& now, const Pose& baseFromWrist,
+                JointPoses& joints);
+
+}  // namespace sdfg

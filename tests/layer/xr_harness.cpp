@@ -398,7 +398,7 @@ void App::pollEvents() {
   }
 }
 
-void App::frame() {
+void App::frame(const std::function<void()>& beforeEnd) {
   pollEvents();
   if (!running_) return;
   // Info structs passed although they may be null: the mock runtime's null check is broken
@@ -416,6 +416,7 @@ void App::frame() {
     si.activeActionSets = &active;
     lastSync = xrSyncActions(session, &si);
   }
+  if (beforeEnd) beforeEnd();
   XrFrameEndInfo ei{XR_TYPE_FRAME_END_INFO};
   ei.displayTime = fs.predictedDisplayTime;
   ei.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_OPAQUE;

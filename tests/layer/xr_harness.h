@@ -15,6 +15,7 @@
 
 #include <array>
 #include <chrono>
+#include <functional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -95,8 +96,9 @@ class App {
     return reinterpret_cast<F>(f);
   }
 
-  // One frame: events, wait, begin, sync actions, end.
-  void frame();
+  // One frame: events, wait, begin, sync actions, `beforeEnd` (where an app locates its hands
+  // and renders: the poses of this frame), end.
+  void frame(const std::function<void()>& beforeEnd = {});
   void frames(int n) {
     for (int i = 0; i < n; ++i) frame();
   }

@@ -1,0 +1,294 @@
+// The outer hand as a GraspSession runs it (grasp_session_outer.cpp): the job on the worker, the
+// fallback an update decides before the job's result is in, and the hand drawn from both as the
+// layer draws it (shown_hand.h). A tracked hand moves through analytic scenes with known answers.
+// Frames either wait for the worker's result with a time bound (the on-time path) or are paced
+// at 90 Hz and drawn at once (whatever the worker has done by then: the fallback or the result).
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <thread>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "grasp/grasp_session.h"
+#include "grasp/hand_clearance.h"
+#include "grasp/shown_hand.h"
+#include "hand/hand_synthesis.h"
+#include "io/shapes.h"
+#include "sdf/sdf_backend.h"
+
+using namespace sdfg;
+
+namespace {
+
+using namespace std::chrono_literals;
+
+constexpr int64_t kFrameNs = 11'111'111;  // 90 Hz
+
+Pose at(const glm::vec3& p) {
+  return Pose{glm::quat(1, 0, 0, 0), p};
+}
+
+// One right hand, tracked (26 joints), open, driven through a session with the outer hand on.
+struct Rig {
+  GraspSession session{makeCpuSdfBackend(1)};
+  HandModel model = HandModel::defaultAdult(Hand::right);
+  JointPoses local{};
+  JointRadii radii{};
+  std::vector<TargetFrame> targets;
+  int64_t time = kFrameNs;
+  bool paced = false;  // frames 11 ms apart, drawn without waiting for the worker
+  std::chrono::steady_clock::time_point next = std::chrono::steady_clock::now();
+
+  explicit Rig(bool outer = true) {
+    GraspSettings s;
+    s.solver = "ours";
+    s.outerHand = outer;
+    REQUIRE(session.configure(s) == Status::ok);
+    model.pose(FingerCurls{}, local);
+    for (int j = 0; j < kJointCount; ++j) radii[size_t(j)] = model.jointRadius(Joint(j));
+  }
+  void addShape(uint64_t id, const AnalyticShape& shape, const Pose& worldFromShape,
+                TargetRole role = TargetRole::scene) {
+    REQUIRE(session.addShapeTarget(id, shape) == Status::ok);
+    REQUIRE(session.setTargetRole(id, role) == Status::ok);
+    targets.push_back({id, true, worldFromShape});
+  }
+  void addMesh(uint64_t id, TriangleMesh mesh, const Pose& worldFromObject) {
+    REQUIRE(session.addTarget(id, std::move(mesh)) == Status::ok);
+    targets.push_back({id, true, worldFromObject});
+    const auto deadline = std::chrono::steady_clock::now() + 30s;
+    while (session.targetSetup(id) != TargetSetup::ready) {
+      REQUIRE(session.targetSetup(id) != TargetSetup::failed);
+      REQUIRE(std::chrono::steady_clock::now() < deadline);
+      std::this_thread::sleep_for(1ms);
+    }
+  }
+  JointPoses tracked(const Pose& wrist) const {
+    JointPoses world;
+    for (int j = 0; j < kJointCount; ++j) world[size_t(j)] = wrist * local[size_t(j)];
+    return world;
+  }
+  // One frame with the tracked wrist at `wrist`: the joints as the app reads them.
+  JointPoses frame(const Pose& wrist, float squeeze = 0.0f) {
+    const JointPoses world = tracked(wrist);
+    HandFrame f;
+    f.valid = true;
+    f.worldFromWrist = wrist;
+    f.squeeze = squeeze;
+    f.trackedJoints = &world;
+    f.trackedRadii = &radii;
+    f.time = time;
+    time += kFrameNs;
+    if (paced) {
+      next += std::chrono::nanoseconds(kFrameNs);
+      std::this_thread::sleep_until(next);
+    }
+    REQUIRE(session.update(Hand::right, f, std::span<const TargetFrame>(targets)) == Status::ok);
+    if (!paced) REQUIRE(session.waitWorkerIdle(5000ms));
+    const ShownHand view = takeShownHand(session, Hand::right, HandOffset{}, squeeze);
+    JointPoses drawn = world;
+    std::array<bool, kJointCount> changed{};
+    drawTrackedHand(view, drawn, changed);
+    return drawn;
+  }
+};
+
+// The deepest any part of the drawn hand is inside the box (positive: inside), metres.
+float depthIn(const JointPoses& joints, const JointRadii& radii, const AnalyticShape& box,
+              const Pose& worldFromBox) {
+  HandParts parts;
+  const int n = jointParts(joints, radii, parts);
+  const Pose boxFromWorld = worldFromBox.inverse();
+  float deepest = -std::numeric_limits<float>::infinity();
+  for (int i = 0; i < n; ++i) {
+    const float d = box.signedDistance(boxFromWorld.transformPoint(parts[size_t(i)].centre));
+    deepest = std::max(deepest, parts[size_t(i)].radius - d);
+  }
+  return deepest;
+}
+
+float largestMotion(const JointPoses& a, const JointPoses& b) {
+  float m = 0.0f;
+  for (int j = 0; j < kJointCount; ++j)
+    m = std::max(m, glm::length(a[size_t(j)].position - b[size_t(j)].position));
+  return m;
+}
+
+bool sameJoints(const JointPoses& a, const JointPoses& b) {
+  for (int j = 0; j < kJointCount; ++j) {
+    if (a[size_t(j)].position != b[size_t(j)].position) return false;
+    if (a[size_t(j)].orientation != b[size_t(j)].orientation) return false;
+  }
+  return true;
+}
+
+// The wrist height at which the open hand's lowest part just touches y = 0.
+float touchHeight(const Rig& rig) {
+  HandParts parts;
+  const int n = jointParts(rig.local, rig.radii, parts);
+  float lowest = std::numeric_limits<float>::infinity();
+  for (int i = 0; i < n; ++i)
+    lowest = std::min(lowest, parts[size_t(i)].centre.y - parts[size_t(i)].radius);
+  return -lowest;
+}
+
+const AnalyticShape kTable{ShapeKind::box, glm::vec3(0.5f, 0.02f, 0.5f)};
+const Pose kWorldFromTable = at(glm::vec3(0.0f, -0.02f, 0.0f));  // its top at y = 0
+
+}  // namespace
+
+TEST_CASE("Session outer hand: a hand far from every target is drawn exactly as tracked",
+          "[core][outer_hand]") {
+  Rig rig;
+  rig.addShape(1, kTable, kWorldFromTable);
+  for (int k = 0; k < 20; ++k) {
+    const Pose wrist = at(glm::vec3(0.01f * float(k), 0.6f, 0.0f));  // 0.6 m above the table
+    const JointPoses drawn = rig.frame(wrist);
+    CHECK_FALSE(rig.session.outerView(Hand::right).active);
+    CHECK(sameJoints(drawn, rig.tracked(wrist)));
+  }
+}
+
+TEST_CASE("Session outer hand: near but clear, the hand is drawn exactly as tracked",
+          "[core][outer_hand]") {
+  Rig rig;
+  rig.addShape(1, kTable, kWorldFromTable);
+  const float touch = touchHeight(rig);
+  for (int k = 0; k < 30; ++k) {
+    // 2 cm to 5 mm above the table, moving along it: engaged, never constrained.
+    const Pose wrist = at(glm::vec3(0.005f * float(k), touch + 0.02f - 0.0005f * float(k), 0.0f));
+    const JointPoses drawn = rig.frame(wrist);
+    CHECK(rig.session.outerView(Hand::right).active);
+    CHECK(sameJoints(drawn, rig.tracked(wrist)));
+  }
+}
+
+TEST_CASE("Session outer hand: a hand pushed into a table is drawn on it, slides and comes out",
+          "[core][outer_hand]") {
+  Rig rig;
+  rig.addShape(1, kTable, kWorldFromTable);
+  const float touch = touchHeight(rig);
+  float deepest = 0.0f;
+  JointPoses drawn;
+  // Down at 0.9 m/s to 3 cm inside, then 10 cm along the table 3 cm inside.
+  for (int k = 0; k <= 8; ++k) {
+    drawn = rig.frame(at(glm::vec3(0.0f, touch + 0.05f - 0.01f * float(k), 0.0f)));
+    deepest = std::max(deepest, depthIn(drawn, rig.radii, kTable, kWorldFromTable));
+  }
+  for (int k = 1; k <= 20; ++k) {
+    drawn = rig.frame(at(glm::vec3(0.005f * float(k), touch - 0.03f, 0.0f)));
+    deepest = std::max(deepest, depthIn(drawn, rig.radii, kTable, kWorldFromTable));
+  }
+  CHECK(deepest <= 0.001f);
+  // It slid: the wrist is drawn over the tracked one's x, on the surface.
+  CHECK(drawn[size_t(Joint::wrist)].position.x == Approx(0.1f).margin(0.005f));
+  CHECK(depthIn(drawn, rig.radii, kTable, kWorldFromTable) > -0.002f);
+  // Still, 3 cm inside: the drawn hand does not move (no jitter).
+  JointPoses last = drawn;
+  float jitter = 0.0f;
+  for (int k = 0; k < 30; ++k) {
+    drawn = rig.frame(at(glm::vec3(0.1f, touch - 0.03f, 0.0f)));
+    jitter = std::max(jitter, largestMotion(drawn, last));
+    last = drawn;
+  }
+  CHECK(jitter <= 0.0001f);
+  // Out again: exactly the tracked hand.
+  for (int k = 1; k <= 8; ++k) drawn = rig.frame(at(glm::vec3(0.1f, touch - 0.03f + 0.01f * k, 0)));
+  CHECK(sameJoints(drawn, rig.tracked(at(glm::vec3(0.1f, touch + 0.05f, 0.0f)))));
+}
+
+TEST_CASE("Session outer hand: paced at 90 Hz and drawn at once, the hand stays out of the table",
+          "[core][outer_hand]") {
+  // Drawn right after each update, before or after the worker's result: either way clear (the
+  // fallback is the last clear result, or the tracked hand where that result was clear by more
+  // than the hand moved since).
+  Rig rig;
+  rig.paced = true;
+  rig.addShape(1, kTable, kWorldFromTable);
+  const float touch = touchHeight(rig);
+  float deepest = 0.0f;
+  for (int k = 0; k <= 60; ++k) {
+    // Down 1 cm a frame to 3 cm inside, then sideways 5 mm a frame.
+    const float y = std::max(touch - 0.03f, touch + 0.05f - 0.01f * float(k));
+    const float x = 0.005f * float(std::max(0, k - 8));
+    const JointPoses drawn = rig.frame(at(glm::vec3(x, y, 0.0f)));
+    deepest = std::max(deepest, depthIn(drawn, rig.radii, kTable, kWorldFromTable));
+  }
+  CHECK(deepest <= 0.001f);
+}
+
+TEST_CASE("Session outer hand: a hand swiped at 2 m/s through a 3 mm plate stays on its side",
+          "[core][outer_hand]") {
+  Rig rig;
+  const AnalyticShape plate{ShapeKind::box, glm::vec3(0.2f, 0.0015f, 0.2f)};
+  const Pose worldFromPlate = at(glm::vec3(0.0f, 0.0f, 0.0f));  // faces at y = +-1.5 mm
+  rig.addShape(1, plate, worldFromPlate);
+  const float touch = touchHeight(rig) + 0.0015f;
+  float deepest = 0.0f, lowestWrist = std::numeric_limits<float>::infinity();
+  // 2 m/s: 22 mm a frame, from 4 cm above to 7 cm past (within the release distance, 10 cm,
+  // past which the hand would return to tracking on purpose), and held there.
+  for (int k = 0; k <= 15; ++k) {
+    const float y = touch + 0.04f - 0.022f * float(std::min(k, 5));
+    const JointPoses drawn = rig.frame(at(glm::vec3(0.0f, y, 0.0f)));
+    deepest = std::max(deepest, depthIn(drawn, rig.radii, plate, worldFromPlate));
+    lowestWrist = std::min(lowestWrist, drawn[size_t(Joint::wrist)].position.y);
+  }
+  CHECK(deepest <= 0.001f);
+  CHECK(lowestWrist > touch - 0.002f);  // never on the far side
+}
+
+TEST_CASE("Session outer hand: switched off, the hand is drawn as tracked inside the table",
+          "[core][outer_hand]") {
+  Rig rig(false);
+  rig.addShape(1, kTable, kWorldFromTable);
+  const Pose wrist = at(glm::vec3(0.0f, touchHeight(rig) - 0.02f, 0.0f));
+  const JointPoses drawn = rig.frame(wrist);
+  CHECK_FALSE(rig.session.outerView(Hand::right).active);
+  CHECK(sameJoints(drawn, rig.tracked(wrist)));
+  CHECK(depthIn(drawn, rig.radii, kTable, kWorldFromTable) > 0.015f);
+}
+
+TEST_CASE("Session outer hand: a held object is kept out of the table with the hand",
+          "[core][outer_hand]") {
+  Rig rig;
+  rig.addShape(1, kTable, kWorldFromTable);
+  // A 4 cm block under the palm, 1 cm above the table, graspable.
+  const float touch = touchHeight(rig);
+  const Pose wrist0 = at(glm::vec3(0.0f, touch + 0.10f, 0.0f));
+  const glm::vec3 palm = rig.tracked(wrist0)[size_t(Joint::palm)].position;
+  const Pose worldFromBlock = at(glm::vec3(palm.x, palm.y - 0.045f, palm.z));
+  rig.addMesh(2, makeBox(glm::vec3(0.04f)), worldFromBlock);
+  // Squeeze until the grasp holds the block.
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (!rig.session.grasp(Hand::right).holdsTarget()) {
+    REQUIRE(std::chrono::steady_clock::now() < deadline);
+    rig.frame(wrist0, 1.0f);
+  }
+  REQUIRE(rig.session.grasp(Hand::right).target == 2);
+  // The app carries the block with the hand it draws: block in the drawn wrist's frame.
+  const JointPoses held = rig.frame(wrist0, 1.0f);
+  const Pose wristFromBlock = held[size_t(Joint::wrist)].inverse() * worldFromBlock;
+  rig.targets[1].worldFromObject = held[size_t(Joint::wrist)] * wristFromBlock;
+  // Down 1 cm a frame to 5 cm below where the block touches the table.
+  const float blockBottom = worldFromBlock.position.y - 0.02f;
+  JointPoses drawn = held;
+  float deepest = -1.0f;
+  for (int k = 1; k <= 12; ++k) {
+    const Pose wrist = at(wrist0.position - glm::vec3(0.0f, 0.01f * float(k), 0.0f));
+    rig.targets[1].worldFromObject = drawn[size_t(Joint::wrist)] * wristFromBlock;
+    drawn = rig.frame(wrist, 1.0f);
+    REQUIRE(rig.session.grasp(Hand::right).target == 2);
+    const Pose block = drawn[size_t(Joint::wrist)] * wristFromBlock;
+    // The block's lowest corner (axis-aligned while the hand only translates).
+    const float bottom = block.position.y - 0.02f;
+    deepest = std::max(deepest, -bottom);
+  }
+  CHECK(blockBottom - 0.12f < -0.02f);  // the tracked block went 5 cm into the table
+  // Surface samples: a table face between them can dent the block by their spacing.
+  CHECK(deepest <= 0.0015f);
+}

@@ -26,7 +26,7 @@ if ! grep -q "^autograsp-demo: 3 objects, 9 grasps" "$work/stdout.txt"; then
 fi
 # The table scene: each grasp takes the object the hand was placed on (not the table, which is
 # scene geometry, nor the neighbour).
-for object in mug block; do
+for object in mug block comb; do
   if ! grep -q "^  table scene: placed on the $object, took the $object," "$work/stdout.txt"; then
     echo "FAIL: the grasp placed on the $object did not take it"; fail=1
   fi

@@ -3,13 +3,13 @@
 // Per object: <object>-grasp.png is (3 * WIDTH + 8) x WIDTH, each of its three panels holds many
 // colours, the object's blue-grey and the hand's skin tone, and the image has contact magenta;
 // <object>-sdf-slice.png is WIDTH x WIDTH with inside blue, outside red and the black surface.
-// table-scene.png is (3 * WIDTH + 8) x WIDTH with the hand, the objects, the table and contacts in
-// every panel; outer-hand.png is 5 x 2 panels of WIDTH / 2 (4 px apart), the tracked hand grey in
-// the top row and the shown hand in skin tone in the bottom one. report.md and report.html exist,
-// show every picture, have 15 finger rows per object (before the table scene) and no non-finite
-// number, and name the commit of the code that made them; the outer hand's tracked hand goes
-// more than 2 cm into the table and the shown one less than 1 mm. Prints each failed check; exit
-// status 1 when any failed.
+// table-scene.png is 4 panels of WIDTH (4 px apart: the scene, then each of its 3 grasps) with the
+// hand, the objects, the table and contacts in every panel; outer-hand.png is 5 x 2 panels of WIDTH
+// / 2 (4 px apart), the tracked hand grey in the top row and the shown hand in skin tone in the
+// bottom one. report.md and report.html exist, show every picture, have 15 finger rows per object
+// (before the table scene) and no non-finite number, and name the commit of the code that made
+// them; the outer hand's tracked hand goes more than 2 cm into the table and the shown one less
+// than 1 mm. Prints each failed check; exit status 1 when any failed.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -109,9 +109,10 @@ void checkScene(const std::string& dir, uint32_t w, const std::string& md,
   const std::string png = "table-scene.png";
   checkShown(png, md, html);
   std::vector<uint8_t> rgba;
-  if (!readPicture(dir, png, 3 * w + 8, w, rgba)) return;
-  for (uint32_t p = 0; p < 3; ++p) {
-    const Counts c = count(rgba, 3 * w + 8, p * (w + 4), p * (w + 4) + w, w);
+  constexpr uint32_t kPanels = 4;
+  if (!readPicture(dir, png, kPanels * w + (kPanels - 1) * 4, w, rgba)) return;
+  for (uint32_t p = 0; p < kPanels; ++p) {
+    const Counts c = count(rgba, kPanels * w + (kPanels - 1) * 4, p * (w + 4), p * (w + 4) + w, w);
     const std::string name = "table scene panel " + std::to_string(p);
     check(c.hand > c.pixels / 100, name + ": hand colour on " + std::to_string(c.hand) + " px");
     check(c.object > c.pixels / 200,

@@ -62,9 +62,9 @@ void usage(FILE* f) {
       "                      [--resolution N] [--help]\n\n"
       "Grasps objects through OpenXR (Khronos loader, SDF Autograsp layer, mock runtime)\n"
       "with the physics-convex, paper and ours strategies from the same hand placement,\n"
-      "renders them with Vulkan and writes PNG pictures and a report; then grasps a table\n"
-      "scene (a mug and a block on a table top) and shows the outer hand pushed into the\n"
-      "table (tracked and shown hand), both with the engine in this process.\n\n"
+      "renders them with Vulkan and writes PNG pictures and a report. Then, with the\n"
+      "engine in this process: a table scene (a mug, a block and a comb on a table top)\n"
+      "grasped, and the outer hand (a hand pushed into a table, tracked and shown).\n\n"
       "  --out DIR         output folder (default out/demo)\n"
       "  --mesh FILE       also grasp this OBJ or PLY file (repeatable); scaled to hand size\n"
       "  --embedded-only   only the built-in mug, torus and thin plate (not %s)\n"
@@ -495,7 +495,8 @@ int main(int argc, char** argv) {
   }
 
   // The table scene and the outer hand: the engine in this process (no OpenXR).
-  progress.step(1, 2, "table scene", "grasping the mug and the block (GraspSession, ours)");
+  progress.step(1, 2, "table scene",
+                "grasping the mug, the block and the comb (GraspSession, ours)");
   SceneReport sceneReport;
   TableSceneOptions sceneOptions;
   sceneOptions.width = opt.width;

@@ -145,15 +145,16 @@ Grasp graspOnce(GraspSession& session, const std::vector<Object>& objects,
 
 bool runTableScene(Renderer& renderer, const TableSceneOptions& options, SceneReport& report,
                    std::string& error) {
-  // World: y up, the table top at y = 0; the mug (handle to +X) and the block 21 cm apart.
+  // World: y up, the table top at y = 0; the mug (handle to +X) and the block 21 cm apart, a
+  // comb lying in front of the block.
   std::vector<Object> objects;
   {
     Object table;
     table.id = 1;
     table.name = "table";
-    table.shape = AnalyticShape{ShapeKind::box, glm::vec3(0.25f, 0.02f, 0.16f)};
+    table.shape = AnalyticShape{ShapeKind::box, glm::vec3(0.25f, 0.02f, 0.2f)};
     table.mesh = makeBox(2.0f * table.shape->halfExtents);
-    table.worldFromObject = Pose{glm::quat(1, 0, 0, 0), glm::vec3(0.0f, -0.02f, 0.0f)};
+    table.worldFromObject = Pose{glm::quat(1, 0, 0, 0), glm::vec3(0.0f, -0.02f, 0.03f)};
     table.colour = kTableColour;
     objects.push_back(std::move(table));
     Object mug;
@@ -170,11 +171,18 @@ bool runTableScene(Renderer& renderer, const TableSceneOptions& options, SceneRe
     block.worldFromObject = Pose{glm::quat(1, 0, 0, 0), glm::vec3(0.10f, 0.025f, 0.0f)};
     block.colour = kObjectColour;
     objects.push_back(std::move(block));
+    Object comb;  // flat: no finger reaches under it, they close past it onto the table
+    comb.id = 4;
+    comb.name = "comb";
+    comb.mesh = makeBox(glm::vec3(0.025f, 0.006f, 0.12f));
+    comb.worldFromObject = Pose{glm::quat(1, 0, 0, 0), glm::vec3(0.10f, 0.003f, 0.13f)};
+    comb.colour = kObjectColour;
+    objects.push_back(std::move(comb));
   }
   // The right hand round the mug's body from its front left, upright (the thumb up, the little
   // finger down by the table), as a controller's handle 3.5 cm out of the mug's axis would sit;
-  // then palm down over the block, the fingers across it toward +X. The little finger and the
-  // fingertips end near the table, which they must stop on.
+  // then palm down over the block, the fingers across it toward +X; then the same over the
+  // comb. The little finger and the fingertips end near the table, which they must stop on.
   GraspSession session(makeCpuSdfBackend(1));
   const HandModel& model = session.model(Hand::right);
   const glm::vec3 outward = glm::normalize(glm::vec3(-1.0f, 0.0f, 0.6f));
@@ -187,18 +195,23 @@ bool runTableScene(Renderer& renderer, const TableSceneOptions& options, SceneRe
   // The palm's surface 8 mm over the block's top, 1.5 cm toward the wrist from its middle.
   const glm::vec3 palm(0.085f, 0.05f + model.jointRadius(Joint::palm) + 0.008f, 0.0f);
   const Pose overBlock{fingersToX, palm - fingersToX * open[size_t(Joint::palm)].position};
-  const std::vector<Placement> placements = {{"mug", aroundMug}, {"block", overBlock}};
+  const glm::vec3 palmOverComb(0.10f, 0.006f + model.jointRadius(Joint::palm) + 0.008f, 0.13f);
+  const Pose overComb{fingersToX, palmOverComb - fingersToX * open[size_t(Joint::palm)].position};
+  const std::vector<Placement> placements = {
+      {"mug", aroundMug}, {"block", overBlock}, {"comb", overComb}};
   report.description =
-      "A table top (an analytic box, role scene: the hands stop on it and never take it), a "
-      "mug and a 6 x 5 x 10 cm block standing on it, registered in one `GraspSession` (the "
-      "engine the layer runs) with the `ours` strategy. The right hand is placed round the "
-      "mug (upright, the little finger by the table), then palm down over the block, and "
-      "squeezes; the fingers close on everything in "
-      "the grab box, and the session takes the graspable object the fingers touch "
-      "(grasp/target_choice.h). Left: both grasps in the scene; middle and right: each close "
-      "up. Table grey-green, objects blue-grey, contacts magenta. Clearances are the least "
-      "exact distance of the hand's surface (palm sphere, finger capsules) from the table and "
-      "from the objects; negative: that deep inside.";
+      "A table top (an analytic box, role scene: the hands stop on it and never take it) with "
+      "a mug, a 6 x 5 x 10 cm block and a 12 cm comb 6 mm thick on it, registered in one "
+      "`GraspSession` (the engine the layer runs) with the `ours` strategy. The right hand is "
+      "placed round the mug (upright, the little finger by the table), then palm down over the "
+      "block, then over the comb, and squeezes; the fingers close on everything in the grab "
+      "box, and the session takes the graspable object the hand touches "
+      "(grasp/target_choice.h: the one most fingers touch; the comb, which no finger reaches "
+      "under, is taken because the palm touches it while the fingers rest on the table). "
+      "Left: every grasp in the scene; then each close up. Table grey-green, objects "
+      "blue-grey, contacts magenta. Clearances are the least exact distance of the hand's "
+      "surface (palm sphere, finger capsules) from the table and from the objects; negative: "
+      "that deep inside.";
 
   GraspSettings settings;
   settings.solver = "ours";
@@ -255,8 +268,8 @@ bool runTableScene(Renderer& renderer, const TableSceneOptions& options, SceneRe
       for (const auto& q : grasps[k].contacts)
         appendSphere(list.overlay, q, panel == 0 ? 0.005f : 0.004f, kContactColour, true);
     }
-    glm::vec3 centre(0.0f, 0.05f, 0.0f);
-    float radius = 0.26f;
+    glm::vec3 centre(0.02f, 0.04f, 0.05f);
+    float radius = 0.3f;
     if (panel > 0) {
       const Aabb& b = grasps[panel - 1].focus;
       centre = 0.5f * (b.min + b.max);

@@ -174,16 +174,17 @@ void writeScene(std::ostream& md, std::ostream& html, const SceneReport& scene) 
     html << "<p class=\"fail\">The scene did not run (see above).</p>\n";
     return;
   }
-  md << "![table scene: both grasps, then each close up](" << scene.png << ")\n\n";
+  md << "![table scene: every grasp, then each close up](" << scene.png << ")\n\n";
   html << "<p><img src=\"" << scene.png << "\" alt=\"table scene\">\n<span class=\"caption\">"
-       << "left: both grasps; then each grasp close up</span></p>\n<ul>\n";
+       << "left: every grasp; then each close up</span></p>\n<ul>\n";
   for (const auto& g : scene.grasps) {
     std::string line = "hand placed on the " + g.aim + ": ";
     if (!g.ok)
       line += "failed: " + g.error;
     else
-      line += "took the " + g.took + ", " + std::to_string(g.contacts) +
-              " fingers in contact; hand in the table: " + depth(g.tableMm) +
+      line += "took the " + g.took + ", " + std::to_string(g.contacts) + " fingers in contact (" +
+              std::to_string(g.fingersOnTaken) + " on the " + g.took +
+              "); hand in the table: " + depth(g.tableMm) +
               "; in the objects: " + depth(g.objectsMm) + "; open hand moved " +
               num(g.handMovedMm, 1) + " mm; shown " + num(float(g.milliseconds), 0) +
               " ms after the squeeze";

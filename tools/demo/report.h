@@ -53,6 +53,7 @@ struct SceneGraspRow {
   std::array<std::string, 5> touched{};  // per finger: the object its contact is on, or "-"
   std::array<float, 5> curl{};
   int contacts = 0;
+  int fingersOnTaken = 0;  // of those, the fingers whose contact is on the object taken
   // Least exact clearance of the whole hand, mm (negative: inside), against the table and against
   // every object of the scene but the table.
   float tableMm = 0.0f;

@@ -118,6 +118,7 @@ Grasp graspOnce(GraspSession& session, const std::vector<Object>& objects,
         contact && held.touched[size_t(f)] != 0 ? nameOf(objects, held.touched[size_t(f)]) : "-";
     if (contact) {
       ++g.row.contacts;
+      if (held.target != 0 && held.touched[size_t(f)] == held.target) ++g.row.fingersOnTaken;
       g.contacts.push_back(shownWrist.transformPoint(r.fingers[f].contactPoint));
     }
   }

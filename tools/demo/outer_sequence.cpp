@@ -145,7 +145,7 @@ bool runOuterSequence(Renderer& renderer, const OuterSequenceOptions& options, O
   const uint32_t w = options.width / 2, gap = 4;
   const uint32_t totalW = kColumns * w + (kColumns - 1) * gap, totalH = 2 * w + gap;
   std::vector<uint8_t> picture(size_t(totalW) * totalH * 4, 255);
-  const glm::vec3 centre(0.0f, 0.035f, -0.10f);
+  const glm::vec3 centre(0.0f, 0.05f, -0.095f);
   const glm::vec3 toCamera = glm::normalize(glm::vec3(1.0f, 0.35f, 0.0f));
   glm::vec3 light;
   const glm::mat4 vp = lookCamera(centre, 0.2f, toCamera, {0, 1, 0}, 1.0f, light);

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <filesystem>
+#include <thread>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -87,7 +89,12 @@ bool runOuterSequence(Renderer& renderer, const OuterSequenceOptions& options, O
   const std::array<size_t, kColumns> pictured = {0, 9, 17, 25, frames.size() - 1};
   std::array<HandPose, kColumns> trackedShots{}, shownShots{};
   report.frames.clear();
+  // Paced as an app's frames are (the outer hand's own clock is in.time, so the pacing changes
+  // no result; it keeps the demo's frame loops alike).
+  auto next = std::chrono::steady_clock::now();
   for (size_t k = 0; k < frames.size(); ++k) {
+    std::this_thread::sleep_until(next);
+    next += std::chrono::microseconds(11111);
     OuterHandInput in;
     in.worldFromWrist = frames[k].tracked;
     in.joints = &joints;

@@ -1,9 +1,9 @@
 // The demo's outer hand sequence (issue 27): a right hand reaches down into a table top and
 // slides along it inside, then lifts out, as a tracked hand may when nothing stops the user's
-// real hand. The engine's OuterHand (grasp/outer_hand.h), driven here frame by frame at 90 Hz
-// times, keeps the shown hand on the table's surface and slides it along. The picture sets the
-// tracked hand (grey, top row) over the shown hand (colour, bottom row) for a few of the frames;
-// the report gives, per frame, how deep each of them is in the table.
+// real hand. The engine's OuterHand (grasp/outer_hand.h), driven here frame by frame at 90 Hz,
+// keeps the shown hand on the table's surface and slides it along. The picture sets the tracked
+// hand (grey, top row) over the shown hand (colour, bottom row) for a few of the frames; the
+// report gives, per frame, how deep each of them is in the table.
 #pragma once
 
 #include <string>

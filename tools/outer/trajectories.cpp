@@ -171,10 +171,10 @@ std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale) {
     out.push_back(std::move(t));
   }
 
-  // 2. Through a 3 mm plate at 2 m/s (6 cm past its touch: inside the release distance).
-  for (float speed : {2.0f, 3.0f}) {
+  // 2. Through a 3 mm plate at 2, 3 and 5 m/s (6 cm past its touch: inside the release distance).
+  for (float speed : {2.0f, 3.0f, 5.0f}) {
     Trajectory t;
-    t.name = speed == 2.0f ? "plate_push_2ms" : "plate_push_3ms";
+    t.name = "plate_push_" + std::to_string(int(speed)) + "ms";
     t.description = "palm first through a 3 mm plate (30 x 30 cm mesh) to 6 cm past its touch";
     t.objects.push_back(meshObject("plate", 2, makeThinPlate(0.30f, 0.30f, 0.003f), Pose{}));
     t.pass = PassCheck{Pose{}, 0.0015f, glm::vec2(0.15f, 0.15f)};
@@ -216,10 +216,11 @@ std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale) {
     out.push_back(std::move(t));
   }
 
-  // 4. Fast swipes through thin parts: a ring 1 cm thick, and the edge of an upright plate.
-  for (float speed : {2.0f, 3.0f}) {
+  // 4. Fast swipes through thin parts (2, 3 and 5 m/s): a ring 1 cm thick, and an upright plate
+  // 1 cm below its top edge.
+  for (float speed : {2.0f, 3.0f, 5.0f}) {
     Trajectory t;
-    t.name = speed == 2.0f ? "ring_swipe_2ms" : "ring_swipe_3ms";
+    t.name = "ring_swipe_" + std::to_string(int(speed)) + "ms";
     t.description = "palm first into a torus ring (tube 1 cm across) to 6 cm past its touch";
     t.objects.push_back(meshObject("ring", 3, makeTorus(0.06f, 0.005f, 96, 16), Pose{}));
     // Middle finger's intermediate joint at the tube's height and at z = 0 (its nearest point).
@@ -239,9 +240,9 @@ std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale) {
     t.hand = p.take();
     out.push_back(std::move(t));
   }
-  for (float speed : {2.0f, 3.0f}) {
+  for (float speed : {2.0f, 3.0f, 5.0f}) {
     Trajectory t;
-    t.name = speed == 2.0f ? "plate_edge_2ms" : "plate_edge_3ms";
+    t.name = "plate_edge_" + std::to_string(int(speed)) + "ms";
     t.description = "side of the flat hand into an upright 3 mm plate 1 cm below its top edge";
     // Upright: the plate's thin axis (its Y) along the world's -X, its top edge at y = 0.
     const Pose worldFromPlate = at(palmEast, glm::vec3(0.0f, -0.15f, 0.0f));

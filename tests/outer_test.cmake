@@ -20,7 +20,7 @@ foreach(name ${names})
   endif()
 endforeach()
 file(READ ${WORK}/outer.json json)
-foreach(key tool provenance mode frame_period_ms draw_at_ms quick hardware_threads targets
+foreach(key tool provenance mode frame_period_ms draw_at_ms quick squeeze hardware_threads targets
             trajectories)
   string(JSON v ERROR_VARIABLE e GET "${json}" ${key})
   if(e)

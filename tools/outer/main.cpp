@@ -1,11 +1,12 @@
 // autograsp-outer: how well the outer hand (issue 27) keeps a tracked hand's shown pose out of
 // objects, and what it costs per frame.
 //
-// Scripted trajectories of a tracked right hand (26 joints of the default adult model, open)
-// meet a table, a thin plate, the mug and a thin ring (trajectories.h). Each runs twice in one
-// process through an engine-level GraspSession (CPU builds): with GraspSettings::outerHand off,
-// then on. Frames are paced at 90 Hz; the shown hand is read as the layer reads it for an app:
-// takeShownHand right after the update, drawTrackedHand 8 ms into the frame (--draw-at).
+// Scripted trajectories of a tracked right hand (26 joints of the default adult model, open, or
+// every finger curled by --squeeze: the model's curl) meet a table, a thin plate, the mug and a
+// thin ring (trajectories.h). Each runs twice in one process through an engine-level
+// GraspSession (CPU builds): with GraspSettings::outerHand off, then on. Frames are paced at 90 Hz;
+// the shown hand is read as the layer reads it for an app: takeShownHand right after the update,
+// drawTrackedHand 8 ms into the frame (--draw-at).
 //
 // Per trajectory (the outer-on run): the shown hand's penetration into any object per frame
 // (joint spheres with their radii, exact distances), its distance from the tracked hand over the
@@ -44,12 +45,14 @@ using sdfg::tools::Json;
 using sdfg::tools::jsonNumber;
 
 const char* const kUsage =
-    "usage: autograsp-outer [--quick] [--only NAME]... [--wait-worker] [--draw-at MS] [--check]\n"
+    "usage: autograsp-outer [--quick] [--only NAME]... [--wait-worker] [--draw-at MS]\n"
+    "                       [--squeeze S] [--check]\n"
     "                       [--json FILE [--per-frame]]\n"
     "  --quick        shorter holds and slides (the smoke test); speeds and depths stay\n"
     "  --only NAME    run only the trajectory NAME (repeatable)\n"
     "  --wait-worker  wait for the worker before each draw, unpaced: the same figures every run\n"
     "  --draw-at MS   when in its 11.1 ms frame the hand is drawn (default 8)\n"
+    "  --squeeze S    the tracked hand's fingers curled by S in [0, 1] (default 0: open)\n"
     "  --check        exit 3 when a trajectory misses a quality target (distance from tracking\n"
     "                 counted outside the outer hand's keep-out)\n"
     "  --json FILE    write the results as JSON\n"
@@ -237,6 +240,7 @@ Json summaryJson(const Summary& s, bool perFrame) {
 int main(int argc, char** argv) {
   bool quick = false, waitWorker = false, check = false, perFrame = false, help = false;
   float drawAt = 8.0f;
+  float squeeze = 0.0f;
   std::string json;
   std::vector<std::string> only;
   CLI::App cli{"", "autograsp-outer"};
@@ -248,6 +252,9 @@ int main(int argc, char** argv) {
   sdfg::tools::cli::addNumber(
       cli, "--draw-at", drawAt, [](float v) { return v >= 0.0f && v <= 11.0f; },
       "a number of milliseconds from 0 to 11");
+  sdfg::tools::cli::addNumber(
+      cli, "--squeeze", squeeze, [](float v) { return v >= 0.0f && v <= 1.0f; },
+      "a number from 0 to 1");
   sdfg::tools::cli::addRepeatable(cli, "--only", only);
   sdfg::tools::cli::addName(cli, "--json", json, "file name");
   if (auto error = sdfg::tools::cli::parse(cli, argc, argv)) {
@@ -259,7 +266,7 @@ int main(int argc, char** argv) {
     return 0;
   }
 
-  const TrackedHand hand;
+  const TrackedHand hand(squeeze);
   std::vector<Trajectory> trajectories = makeTrajectories(hand, quick ? 0.25f : 1.0f);
   for (const std::string& name : only) {
     if (std::none_of(trajectories.begin(), trajectories.end(),
@@ -294,12 +301,14 @@ int main(int argc, char** argv) {
   }
 
   std::printf(
-      "\nThe outer hand on scripted tracked-hand trajectories, %s; code at commit %s\n"
+      "\nThe outer hand on scripted tracked-hand trajectories (squeeze %.2f), %s; code at commit "
+      "%s\n"
       "penetration: the shown hand's joint spheres, exact distance (capsules: spheres along the "
       "bones); off tracking: largest joint distance shown - tracked over the frames the tracked "
       "hand is clear (and, keep-out, clear by the 0.5 mm margin on the capsules' cover radii); "
       "jitter: shown motion per still frame from 100 ms on (from the first); cost: update + draw, "
       "ms\n\n",
+      double(squeeze),
       waitWorker
           ? "each draw waits for the worker (unpaced)"
           : ("paced at 90 Hz, drawn " + std::to_string(int(drawAt)) + " ms into the frame").c_str(),
@@ -337,6 +346,7 @@ int main(int argc, char** argv) {
               {"frame_period_ms", jsonNumber(1000.0 * kFrameSeconds)},
               {"draw_at_ms", waitWorker ? Json(nullptr) : jsonNumber(double(drawAt))},
               {"quick", quick},
+              {"squeeze", jsonNumber(squeeze)},
               {"hardware_threads", std::thread::hardware_concurrency()},
               {"targets",
                {{"penetration_p99_mm", kPenetrationP99Mm},

@@ -111,9 +111,9 @@ float SceneObject::signedDistance(const glm::vec3& world) const {
   return shape ? shape->signedDistance(p) : distance->signedDistance(p);
 }
 
-TrackedHand::TrackedHand(float squeeze) {
+TrackedHand::TrackedHand(float curl) {
   FingerCurls c;
-  c.fill(squeeze);
+  c.fill(curl);
   model.pose(c, local);
   for (int j = 0; j < kJointCount; ++j) radii[size_t(j)] = model.jointRadius(Joint(j));
 }

@@ -53,7 +53,8 @@ struct TrackedHand {
   HandModel model = HandModel::defaultAdult(Hand::right);
   JointPoses local{};
   std::array<float, kJointCount> radii{};
-  explicit TrackedHand(float squeeze = 0.0f);
+  // `curl`: every finger's curl in the model's curl space (0: open, 1: a fist).
+  explicit TrackedHand(float curl = 0.0f);
   void world(const Pose& worldFromHand, JointPoses& out) const;
 };
 

@@ -734,28 +734,32 @@ int main(int argc, char** argv) {
     results.push_back(std::move(r));
   }
 
-  std::printf(
-      "\nTime the layer adds to the app's OpenXR calls per frame (ms; layer on minus the "
-      "layer-off median of the phase), 90 Hz pacing, %d frames per phase; code at commit %s\n\n",
-      phaseFrames, sdfg::tools::describeBuild().c_str());
-  std::printf("| object | triangles | create call | set-up | grab latency (frames) |");
-  for (const char* p : kPhases) std::printf(" %s p50 / p99 / max |", p);
-  std::printf("\n|---|---:|---:|---:|---:|");
-  for (int p = 0; p < kPhaseCount; ++p) std::printf("---|");
-  std::printf("\n");
   int failures = 0;
-  for (const MeshResult& r : results) {
-    if (!r.ok) {
-      std::printf("| %s | %zu | failed: %s |\n", r.name.c_str(), r.triangles, r.error.c_str());
-      ++failures;
-      continue;
-    }
-    std::printf("| %s | %zu | %.3f ms | %.0f ms | %d |", r.name.c_str(), r.triangles, r.on.createMs,
-                r.on.setupMs, r.on.grabLatencyFrames);
-    for (const Percentiles& a : r.added) std::printf(" %.3f / %.3f / %.3f |", a.p50, a.p99, a.max);
+  // The objects' table, unless only the outer-hand scenario ran.
+  if (!results.empty() || !skipped.empty()) {
+    std::printf(
+        "\nTime the layer adds to the app's OpenXR calls per frame (ms; layer on minus the "
+        "layer-off median of the phase), 90 Hz pacing, %d frames per phase; code at commit %s\n\n",
+        phaseFrames, sdfg::tools::describeBuild().c_str());
+    std::printf("| object | triangles | create call | set-up | grab latency (frames) |");
+    for (const char* p : kPhases) std::printf(" %s p50 / p99 / max |", p);
+    std::printf("\n|---|---:|---:|---:|---:|");
+    for (int p = 0; p < kPhaseCount; ++p) std::printf("---|");
     std::printf("\n");
+    for (const MeshResult& r : results) {
+      if (!r.ok) {
+        std::printf("| %s | %zu | failed: %s |\n", r.name.c_str(), r.triangles, r.error.c_str());
+        ++failures;
+        continue;
+      }
+      std::printf("| %s | %zu | %.3f ms | %.0f ms | %d |", r.name.c_str(), r.triangles,
+                  r.on.createMs, r.on.setupMs, r.on.grabLatencyFrames);
+      for (const Percentiles& a : r.added)
+        std::printf(" %.3f / %.3f / %.3f |", a.p50, a.p99, a.max);
+      std::printf("\n");
+    }
+    for (const std::string& s : skipped) std::printf("| %s | skipped: not found |\n", s.c_str());
   }
-  for (const std::string& s : skipped) std::printf("| %s | skipped: not found |\n", s.c_str());
 
   std::optional<OuterResult> outer;
   if (only.empty() || only.count("outer") != 0) {

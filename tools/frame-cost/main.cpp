@@ -52,6 +52,7 @@
 #include "io/mesh_io.h"
 #include "io/shapes.h"
 #include "mock_runtime_test.h"
+#include "outer_scene.h"
 #include "results.h"
 #include "sdf/sdf_grid.h"
 
@@ -80,12 +81,6 @@ const char* const kUsage =
 double ms(Clock::duration d) {
   return std::chrono::duration<double, std::milli>(d).count();
 }
-
-struct Object {
-  std::string name;
-  std::vector<XrVector3f> vertices;
-  std::vector<uint32_t> indices;
-};
 
 // Centred at the origin and scaled so its largest extent is `extent` metres (the armadillos are
 // in millimetres; every object becomes hand-sized).
@@ -504,92 +499,6 @@ RunResult run(const Object& object, bool layer, int phaseFrames) {
   endPhase(4);
   out.ok = true;
   return out;
-}
-
-// The outer-hand scenario's geometry: the right hand's grip, where the open hand synthesized from
-// it is (its palm and its lowest point), and the targets: a table 5 mm below the hand and four
-// 4 cm boxes on it beside the hand (the five in the hand's box), and `room` - 5 more spread over
-// a 10 x 10 m room at least a metre from the hand (5 cm boxes and 3 cm spheres by turns).
-struct OuterScene {
-  XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
-  float gap = 0.005f;  // between the hand and the table in the near phase, metres
-  std::vector<Object> objects;
-  std::vector<XrPosef> poses;
-  int inHandBox = 0;
-};
-
-Object meshObject(const std::string& name, const sdfg::TriangleMesh& m) {
-  Object o;
-  o.name = name;
-  for (const glm::vec3& p : m.positions) o.vertices.push_back({p.x, p.y, p.z});
-  o.indices = m.indices;
-  return o;
-}
-
-OuterScene outerScene(int room) {
-  OuterScene s;
-  const sdfg::HandModel model = sdfg::HandModel::defaultAdult(sdfg::Hand::right);
-  const sdfg::Pose grip{glm::quat(s.grip.orientation.w, s.grip.orientation.x, s.grip.orientation.y,
-                                  s.grip.orientation.z),
-                        glm::vec3(s.grip.position.x, s.grip.position.y, s.grip.position.z)};
-  sdfg::JointPoses joints;
-  sdfg::JointRadii radii;
-  sdfg::placeJoints(model, sdfg::curlsFromSqueeze(0.0f, sdfg::MotionRange::unobstructed),
-                    grip * sdfg::wristFromGrip(model).inverse(), joints, radii);
-  float lowest = 1e30f;
-  for (int j = 0; j < sdfg::kJointCount; ++j)
-    lowest = std::min(lowest, joints[size_t(j)].position.y - radii[size_t(j)]);
-  const glm::vec3 palm = joints[size_t(sdfg::Joint::palm)].position;
-  const float top = lowest - s.gap;
-  auto place = [&](Object o, const glm::vec3& c) {
-    s.objects.push_back(std::move(o));
-    s.poses.push_back({{0, 0, 0, 1}, {c.x, c.y, c.z}});
-  };
-  place(meshObject("table", sdfg::makeBox(glm::vec3(0.4f, 0.04f, 0.4f))),
-        glm::vec3(palm.x, top - 0.02f, palm.z));
-  const sdfg::TriangleMesh small = sdfg::makeBox(glm::vec3(0.04f));
-  for (const glm::vec2 d : {glm::vec2(0.14f, 0.0f), glm::vec2(-0.14f, 0.0f), glm::vec2(0.0f, 0.14f),
-                            glm::vec2(0.0f, -0.14f)})
-    place(meshObject("block", small), glm::vec3(palm.x + d.x, top + 0.0201f, palm.z + d.y));
-  s.inHandBox = int(s.objects.size());
-  const sdfg::TriangleMesh box = sdfg::makeBox(glm::vec3(0.05f));
-  const sdfg::TriangleMesh ball = sdfg::makeSphere(0.03f, 1);
-  // A grid fine enough for `room` places outside the hand's metre, three shelves high.
-  int side = 2;
-  auto places = [&](int n) {
-    int count = 0;
-    for (int y = 0; y < 3; ++y)
-      for (int i = 0; i < n; ++i)
-        for (int k = 0; k < n; ++k) {
-          const glm::vec3 c(-5.0f + 10.0f * (float(i) + 0.5f) / float(n), 0.5f + float(y),
-                            -5.0f + 10.0f * (float(k) + 0.5f) / float(n));
-          if (glm::length(c - palm) >= 1.0f) ++count;
-        }
-    return count;
-  };
-  const int rest = std::max(0, room - s.inHandBox);
-  while (places(side) < rest) ++side;
-  int added = 0;
-  for (int y = 0; y < 3 && added < rest; ++y)
-    for (int i = 0; i < side && added < rest; ++i)
-      for (int k = 0; k < side && added < rest; ++k) {
-        const glm::vec3 c(-5.0f + 10.0f * (float(i) + 0.5f) / float(side), 0.5f + float(y),
-                          -5.0f + 10.0f * (float(k) + 0.5f) / float(side));
-        if (glm::length(c - palm) < 1.0f) continue;
-        place(meshObject(added % 2 == 0 ? "box" : "ball", added % 2 == 0 ? box : ball), c);
-        ++added;
-      }
-  return s;
-}
-
-// The grip in frame i of the touching phase: down into the table by 2 cm past the touch over the
-// first 10 frames, then sliding +-8 cm along x and back (one period over the phase).
-XrPosef touchingGrip(const OuterScene& s, int i, int frames) {
-  XrPosef g = s.grip;
-  const float down = (s.gap + 0.02f) * std::min(1.0f, float(i + 1) / 10.0f);
-  g.position.y -= down;
-  g.position.x += 0.08f * std::sin(6.2831853f * float(i) / float(frames));
-  return g;
 }
 
 // `outerHand`: the layer's outer_hand setting (through its environment variable).

@@ -143,7 +143,11 @@ int main(int argc, char** argv) {
       failed = failed || r.failedSolves > 0;
       rows.push_back(std::move(r));
     }
-    if (o.scenes) scenes.push_back(tableScene(source.name, *mesh));
+    // A file is named with its extension: the shared torus.obj apart from the embedded torus.
+    if (o.scenes) {
+      scenes.push_back(
+          tableScene(source.path ? source.path->filename().string() : source.name, *mesh));
+    }
     embeddedRan = embeddedRan || !source.path;
     std::fprintf(stderr,
                  "%s: %zu triangles, done in %.1f s (placements + solves %.1f s, grading %.1f s)\n",

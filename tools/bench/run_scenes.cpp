@@ -1,5 +1,6 @@
 #include "run_scenes.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -48,17 +49,19 @@ void printSceneTable(const std::vector<SceneRow>& rows) {
       "\nScenes: the whole hand inside objects it does not hold (mm, per grasp's deepest), "
       "grasps that took another graspable object than the one the palm faces, and the "
       "single-object figures on the object held\n");
-  std::printf("%-20s %-15s %7s %9s %9s %11s %8s %9s %9s %9s %6s %5s\n", "scene", "method", "grasps",
-              "other p99", "other max", "wrong/face", "nothing", "contacts", "resid p95", "pen max",
-              "early", "thru");
+  int width = 20;
+  for (const SceneRow& r : rows) width = std::max(width, int(r.scene.size()));
+  std::printf("%-*s %-15s %7s %9s %9s %11s %8s %9s %9s %9s %6s %5s\n", width, "scene", "method",
+              "grasps", "other p99", "other max", "wrong/face", "nothing", "contacts", "resid p95",
+              "pen max", "early", "thru");
   for (const SceneRow& r : rows) {
     const SceneFigures& f = r.figures;
     const std::string wrong =
         std::to_string(f.wrongObject) + "/" + std::to_string(f.facingGraspable);
-    std::printf("%-20s %-15s %7d %9.3f %9.3f %11s %8d %9.3f %9.4f %9.3f %6d %5d\n", r.scene.c_str(),
-                r.method.c_str(), f.grasps, f.otherPenetrationP99Mm, f.otherPenetrationMaxMm,
-                wrong.c_str(), f.heldNothing, f.contactsPerGrasp, f.contactResidualP95Mm,
-                f.penetrationMaxMm, f.earlyStops, f.passThroughs);
+    std::printf("%-*s %-15s %7d %9.3f %9.3f %11s %8d %9.3f %9.4f %9.3f %6d %5d\n", width,
+                r.scene.c_str(), r.method.c_str(), f.grasps, f.otherPenetrationP99Mm,
+                f.otherPenetrationMaxMm, wrong.c_str(), f.heldNothing, f.contactsPerGrasp,
+                f.contactResidualP95Mm, f.penetrationMaxMm, f.earlyStops, f.passThroughs);
   }
 }
 

@@ -179,14 +179,15 @@ SceneFigures measureEmbeddedScene(const std::string& name) {
   std::printf(
       "%s: %d grasps; objects not held: penetration p99 %.3f mm, max %.3f mm (placement %d, "
       "%s), %d grasps inside one; wrong object %d of %d facing a graspable one (first at %d), "
-      "nothing held %d (in the wrong grasps, fingers on the one taken %d, on the one faced %d); "
+      "nothing held %d (in the wrong grasps, fingers on the one taken %d, on the one faced %d; "
+      "%d with a finger on the one faced); "
       "contacts per grasp %.3f; finger penetration into the held max %.3f mm; contact residual "
       "median %.4f, p95 %.4f mm; early stops %d; pass through %d\n",
       name.c_str(), q.grasps, q.otherPenetrationP99Mm, q.otherPenetrationMaxMm, q.deepestPlacement,
       q.deepestObject.c_str(), q.otherPenetrating, q.wrongObject, q.facingGraspable,
       q.firstWrongPlacement, q.heldNothing, q.wrongFingersOnTaken, q.wrongFingersOnFaced,
-      q.contactsPerGrasp, q.penetrationMaxMm, q.contactResidualMedianMm, q.contactResidualP95Mm,
-      q.earlyStops, q.passThroughs);
+      q.wrongWithFingerOnFaced, q.contactsPerGrasp, q.penetrationMaxMm, q.contactResidualMedianMm,
+      q.contactResidualP95Mm, q.earlyStops, q.passThroughs);
   CHECK(q.grasps == kScenePlacements);
   measuredBefore[name] = q;
   return q;

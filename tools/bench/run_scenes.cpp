@@ -87,6 +87,7 @@ tools::Json scenesJson(const std::vector<SceneRow>& rows) {
     row["held_nothing"] = f.heldNothing;
     row["wrong_fingers_on_taken"] = f.wrongFingersOnTaken;
     row["wrong_fingers_on_faced"] = f.wrongFingersOnFaced;
+    row["wrong_with_finger_on_faced"] = f.wrongWithFingerOnFaced;
     row["contacts_mean"] = jsonNumber(f.contactsPerGrasp);
     row["fingers_in_contact"] = f.fingersInContact;
     // NaN-free: no finger in contact reads as null.

@@ -352,10 +352,13 @@ Result<SceneFigures> measureScene(const BenchScene& scene, const SceneRun& run) 
       } else if (g.taken != g.faced) {
         ++out.wrongObject;
         if (out.firstWrongPlacement < 0) out.firstWrongPlacement = int(p);
+        bool onFaced = false;
         for (int on : g.fingerOn) {
           out.wrongFingersOnTaken += on == g.taken ? 1 : 0;
           out.wrongFingersOnFaced += on == g.faced ? 1 : 0;
+          onFaced = onFaced || on == g.faced;
         }
+        out.wrongWithFingerOnFaced += onFaced ? 1 : 0;
       }
     }
     const GraspMetrics& m = g.metrics;

@@ -65,6 +65,9 @@ struct SceneFigures {
   // contact point's nearest object), summed.
   int wrongFingersOnTaken = 0;
   int wrongFingersOnFaced = 0;
+  // The wrong grasps where some finger in contact was on the object faced: a rule that took the
+  // faced object whenever a finger touches it would have taken it there.
+  int wrongWithFingerOnFaced = 0;
   // Single-object figures on the object held (else the one reached for).
   double contactsPerGrasp = 0.0;  // fingers touching it (within kTouchingMm), mean
   int fingersInContact = 0;

@@ -43,10 +43,12 @@ export WINEDLLOVERRIDES="mscoree,mshtml="
 export VK_ICD_FILENAMES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
 
 key='HKLM\Software\Khronos\OpenXR\1'
+ready="$prefix/.sdfg-prefix-ready"
 if [ "$mode" = setup ]; then
   start=$(date +%s)
-  if [ ! -f "$prefix/system.reg" ]; then
-    mkdir -p "$prefix"
+  # A prefix without the marker is half made (an interrupted run): made again from nothing.
+  if [ ! -f "$ready" ]; then
+    rm -rf "$prefix" && mkdir -p "$prefix"
     timeout 300 wineboot --init >/dev/null 2>&1 || {
       echo "FAIL: wineboot did not make the prefix $prefix within 300 s"; exit 1; }
   fi
@@ -58,11 +60,15 @@ if [ "$mode" = setup ]; then
   timeout 60 wine reg add "$key\\ApiLayers\\Implicit" /v "$layer_win" /t REG_DWORD /d 0 /f \
     >/dev/null
   timeout 60 wine reg query "$key" /s
+  # The server writes the registry to the prefix's files when it exits: wait for that, so the
+  # prefix is whole on disk before the marker says so.
+  timeout 60 wineserver -w || true
+  touch "$ready"
   echo "prefix $prefix ready in $(($(date +%s) - start)) s"
   exit 0
 fi
 
-if [ ! -f "$prefix/system.reg" ]; then
+if [ ! -f "$ready" ]; then
   echo "FAIL: no Wine prefix at $prefix (the windows_wine_prefix test makes it)"
   exit 1
 fi

@@ -19,6 +19,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "base/published.h"
 #include "config.h"
 #include "dispatch.h"
 #include "events.h"
@@ -26,7 +27,6 @@
 #include "grasp/shown_hand.h"
 #include "hand/hand_synthesis.h"
 #include "hand_offset.h"
-#include "published.h"
 #include "sdf/deferred_mailbox.h"
 #include "xr_includes.h"
 

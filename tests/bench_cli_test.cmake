@@ -1,7 +1,8 @@
 # Drives the built autograsp-bench like a user: a short run writes JSON with every key and finite
 # numbers; --exact-check off leaves the exact check out of the "ours" rows; a broken mesh file is
 # named, skipped, and the rest still runs; bad option values are a usage error (exit 2);
-# --sdf-backend vulkan without a device leaves its rows out and exits 3.
+# --sdf-backend vulkan without a device leaves its rows out and exits 3; --scenes writes every
+# method's scene figures.
 # With -DPART=vulkan (a Vulkan device, e.g. lavapipe): --sdf-backend cpu,vulkan gives both rows
 # with finite figures, and --scaling-quick both columns; no device prints SDFG_SKIPPED.
 # Usage: cmake -DBENCH=<autograsp-bench> -DWORK=<scratch dir> [-DPART=vulkan] -P bench_cli_test.cmake
@@ -216,6 +217,46 @@ execute_process(COMMAND "${BENCH}" --embedded-only --placements 1 --methods ours
 if(NOT rc EQUAL 2)
   message(FATAL_ERROR "--clear-hand maybe: exit ${rc}, expected 2 (usage)\n${err}")
 endif()
+
+# 1d. --scenes: every method in every embedded scene, with the scene figures in the JSON and the
+# table; the names of the scenes of several objects are there.
+execute_process(COMMAND "${BENCH}" --embedded-only --placements 3 --seed 2 --scenes
+  --json "${WORK}/scenes.json" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "--scenes exited ${rc}\n${out}\n${err}")
+endif()
+file(READ "${WORK}/scenes.json" json)
+string(JSON count LENGTH "${json}" scenes)
+# 3 embedded objects on a table + 3 scenes of several objects, 4 methods each.
+if(NOT count EQUAL 24)
+  message(FATAL_ERROR "--scenes: ${count} scene rows, expected 24\n${err}")
+endif()
+set(names "")
+math(EXPR last "${count} - 1")
+foreach(i RANGE ${last})
+  string(JSON scene GET "${json}" scenes ${i} scene)
+  list(APPEND names "${scene}")
+  string(JSON grasps GET "${json}" scenes ${i} grasps)
+  if(NOT grasps EQUAL 3)
+    message(FATAL_ERROR "--scenes: row ${i} (${scene}) has ${grasps} grasps, expected 3")
+  endif()
+  foreach(path "other_penetration_mm p99" "other_penetration_mm max" "wrong_object"
+               "facing_graspable" "held_nothing" "contacts_mean" "penetration_mm max")
+    string(REPLACE " " ";" keys "${path}")
+    string(JSON type ERROR_VARIABLE jerr TYPE "${json}" scenes ${i} ${keys})
+    if(NOT type STREQUAL "NUMBER")
+      message(FATAL_ERROR "--scenes: row ${i} (${scene}): ${path} is ${type} ${jerr}")
+    endif()
+  endforeach()
+endforeach()
+foreach(scene mug/table torus/table thin-plate/table mug-beside-mug spoon-in-mug mug-handle-wall)
+  if(NOT scene IN_LIST names)
+    message(FATAL_ERROR "--scenes: no rows for ${scene}")
+  endif()
+  if(NOT out MATCHES "${scene} +ours ")
+    message(FATAL_ERROR "--scenes: no table line for ${scene} / ours\n${out}")
+  endif()
+endforeach()
 
 # 2. A broken file is named and skipped; the good file after it still runs; exit non-zero.
 file(WRITE "${WORK}/broken.obj" "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n")

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The demo test: autograsp-demo on a small setting (embedded objects, 512 px panels) plus a broken
 # mesh file. The broken file must get a clear message naming it, the run must go on and grasp
-# every embedded object, and exit 1 (something was skipped); then autograsp-demo-check checks
-# the pictures and the reports (the commit of the code among them). Last, --help and bad options.
+# every embedded object and each object of the table scene, and exit 1 (something was skipped);
+# then autograsp-demo-check checks the pictures and the reports (the commit of the code among
+# them; the outer hand's depths). Last, --help and bad options.
 # usage: run_demo_test.sh DEMO CHECKER WORK_DIR
 set -uo pipefail
 demo="$1" checker="$2" work="$3"
@@ -23,6 +24,13 @@ fi
 if ! grep -q "^autograsp-demo: 3 objects, 9 grasps" "$work/stdout.txt"; then
   echo "FAIL: the embedded objects were not all grasped after the broken mesh"; fail=1
 fi
+# The table scene: each grasp takes the object the hand was placed on (not the table, which is
+# scene geometry, nor the neighbour).
+for object in mug block comb; do
+  if ! grep -q "^  table scene: placed on the $object, took the $object," "$work/stdout.txt"; then
+    echo "FAIL: the grasp placed on the $object did not take it"; fail=1
+  fi
+done
 if ! grep -q "report are in $work/out/" "$work/stdout.txt"; then
   echo "FAIL: the summary does not say where the files are"; fail=1
 fi

@@ -12,10 +12,13 @@
 #include <catch2/catch.hpp>
 
 #include <cstdio>
+#include <map>
 #include <optional>
 #include <string>
 
 #include "eval/quality.h"
+#include "eval/scene_quality.h"
+#include "eval/scenes.h"
 #include "io/mesh_io.h"
 #include "io/shapes.h"
 #include "test_support.h"
@@ -137,4 +140,111 @@ TEST_CASE("ours meets its published quality on the Stanford dragon", "[quality][
 
 TEST_CASE("ours meets its published quality on the Igea scan (268k)", "[quality][shared]") {
   SDFG_CHECK_SHARED("igea-268k.obj", (Gate{250, 4.88}));
+}
+
+// Scenes (issue 26, eval/scene_quality.h): "ours" among other objects keeps the whole hand out of
+// every object it does not hold (p99 <= 1 mm, max <= 2 mm) and takes the graspable object its
+// palm faces. Fewer placements than the single-object gates (the first 100 of the same seeded
+// sequence) keep the label within its two minutes.
+//
+// Not met, and so not gated as passing: in "mug-beside-mug" and "spoon-in-mug" the hand takes the
+// other graspable object in some grasps (15 and 11 of 100 at the commit that added these tests):
+// target_choice.h takes the object most fingers touch, and where the palm faces the first mug
+// (or the spoon's handle) with more fingers closing onto the neighbour, the neighbour wins. Those
+// two checks run as [!mayfail] cases: their counts are printed and a failure is reported as
+// expected, so the day they pass shows too.
+namespace {
+
+constexpr int kScenePlacements = 100;
+constexpr double kOtherPenetrationP99Mm = 1.0;
+constexpr double kOtherPenetrationMaxMm = 2.0;
+
+// Measured once per scene: the [!mayfail] cases below read the same run as the gated ones.
+SceneFigures measureEmbeddedScene(const std::string& name) {
+  static std::map<std::string, SceneFigures> measuredBefore;
+  if (auto it = measuredBefore.find(name); it != measuredBefore.end()) return it->second;
+  std::optional<BenchScene> scene;
+  for (BenchScene& s : embeddedScenes()) {
+    if (s.name == name) scene = std::move(s);
+  }
+  REQUIRE(scene.has_value());
+  SceneRun run;
+  run.placements = kScenePlacements;
+  run.seed = kSeed;
+  run.threads = kThreads;
+  const Result<SceneFigures> measured = measureScene(*scene, run);
+  INFO((measured.ok() ? std::string() : measured.error().message));
+  REQUIRE(measured.ok());
+  const SceneFigures& q = *measured;
+  std::printf(
+      "%s: %d grasps; objects not held: penetration p99 %.3f mm, max %.3f mm (placement %d, "
+      "%s), %d grasps inside one; wrong object %d of %d facing a graspable one (first at %d), "
+      "nothing held %d (in the wrong grasps, fingers on the one taken %d, on the one faced %d; "
+      "%d with a finger on the one faced); "
+      "contacts per grasp %.3f; finger penetration into the held max %.3f mm; contact residual "
+      "median %.4f, p95 %.4f mm; early stops %d; pass through %d\n",
+      name.c_str(), q.grasps, q.otherPenetrationP99Mm, q.otherPenetrationMaxMm, q.deepestPlacement,
+      q.deepestObject.c_str(), q.otherPenetrating, q.wrongObject, q.facingGraspable,
+      q.firstWrongPlacement, q.heldNothing, q.wrongFingersOnTaken, q.wrongFingersOnFaced,
+      q.wrongWithFingerOnFaced, q.contactsPerGrasp, q.penetrationMaxMm, q.contactResidualMedianMm,
+      q.contactResidualP95Mm, q.earlyStops, q.passThroughs);
+  CHECK(q.grasps == kScenePlacements);
+  measuredBefore[name] = q;
+  return q;
+}
+
+void checkOutOfOthers(const std::string& name, const SceneFigures& q) {
+  INFO(name << ", seed " << kSeed << ": deepest penetration at placement " << q.deepestPlacement
+            << " into " << q.deepestObject);
+  CHECK(q.otherPenetrationP99Mm <= kOtherPenetrationP99Mm);
+  CHECK(q.otherPenetrationMaxMm <= kOtherPenetrationMaxMm);
+}
+
+void checkRightObject(const std::string& name, const SceneFigures& q) {
+  INFO(name << ", seed " << kSeed << ": first wrong object at placement " << q.firstWrongPlacement);
+  CHECK(q.facingGraspable > 0);
+  CHECK(q.wrongObject == 0);
+}
+
+void checkScene(const std::string& name) {
+  const SceneFigures q = measureEmbeddedScene(name);
+  checkOutOfOthers(name, q);
+  checkRightObject(name, q);
+}
+
+}  // namespace
+
+TEST_CASE("ours keeps out of the table under the mug", "[quality][scenes]") {
+  checkScene("mug/table");
+}
+
+TEST_CASE("ours keeps out of the table under the torus", "[quality][scenes]") {
+  checkScene("torus/table");
+}
+
+TEST_CASE("ours keeps out of the table under the thin plate", "[quality][scenes]") {
+  checkScene("thin-plate/table");
+}
+
+TEST_CASE("ours keeps out of the wall behind the mug's handle", "[quality][scenes]") {
+  checkScene("mug-handle-wall");
+}
+
+TEST_CASE("ours keeps out of the mug beside the one it grasps", "[quality][scenes]") {
+  checkOutOfOthers("mug-beside-mug", measureEmbeddedScene("mug-beside-mug"));
+}
+
+TEST_CASE("ours keeps out of the mug the spoon stands in", "[quality][scenes]") {
+  checkOutOfOthers("spoon-in-mug", measureEmbeddedScene("spoon-in-mug"));
+}
+
+// Not met yet (see above): reported, expected to fail.
+TEST_CASE("ours takes the mug its palm faces, not the one beside it",
+          "[quality][scenes][!mayfail]") {
+  checkRightObject("mug-beside-mug", measureEmbeddedScene("mug-beside-mug"));
+}
+
+TEST_CASE("ours takes the spoon its palm faces, not the mug it stands in",
+          "[quality][scenes][!mayfail]") {
+  checkRightObject("spoon-in-mug", measureEmbeddedScene("spoon-in-mug"));
 }

@@ -140,6 +140,50 @@ TEST_CASE("Rows of one method on two SDF backends get a backend column", "[bench
   }
 }
 
+TEST_CASE("A run with --scenes gets a Scenes table, one line per scene and method",
+          "[bench][report]") {
+  const fs::path dir = scratch("scenes");
+  const fs::path json = dir / "in.json";
+  std::ofstream(json) << R"({"placements": 2, "rows": [
+    {"mesh": "cube", "triangles": 12, "method": "ours", "sdf_backend": "cpu", "grasps": 2,
+     "sdf_build_ms": {"median": 1.5}, "solve_us": {"median": 40}, "pass_through": 0}],
+    "scenes": [
+    {"scene": "cube/table", "description": "a cube on a table", "objects": "cube, table",
+     "method": "ours", "grasps": 2, "other_penetration_mm": {"p99": 0.25, "max": 0.5},
+     "facing_graspable": 2, "wrong_object": 1, "held_nothing": 0, "contacts_mean": 4.5,
+     "contact_residual_mm": {"median": 0.05, "p95": null}, "penetration_mm": {"max": 0.125},
+     "early_stops": 0, "pass_through": 0},
+    {"scene": "cube/table", "description": "a cube on a table", "objects": "cube, table",
+     "method": "paper", "grasps": 2, "other_penetration_mm": {"p99": 30, "max": 31},
+     "facing_graspable": 2, "wrong_object": 0, "held_nothing": 1, "contacts_mean": 5,
+     "early_stops": 0, "pass_through": 7}]})";
+  sdfg::bench::ReportRequest request;
+  request.dir = dir / "out";
+  request.resultsJson = json;
+  REQUIRE_FALSE(sdfg::bench::writeReport(request, nullptr).has_value());
+  const std::string md = readAll(request.dir / "benchmarks.md");
+  CHECK(md.find("## Scenes") != std::string::npos);
+  CHECK(md.find("| `cube/table` | ours | 2 | 0.25 | 0.5 | 1 / 2 | 0 | 4.5 | 0.05 | - | 0.125 | "
+                "0 | 0 |") != std::string::npos);
+  // The scene is named once; missing figures are "-".
+  CHECK(md.find("|  | paper | 2 | 30 | 31 | 0 / 2 | 1 | 5 | - | - | - | 0 | 7 |") !=
+        std::string::npos);
+  CHECK(md.find("- `cube/table`: a cube on a table (cube, table)") != std::string::npos);
+}
+
+TEST_CASE("A run without --scenes has no Scenes table", "[bench][report]") {
+  const fs::path dir = scratch("no_scenes");
+  const fs::path json = dir / "in.json";
+  std::ofstream(json) << R"({"placements": 2, "rows": [
+    {"mesh": "cube", "triangles": 12, "method": "ours", "sdf_backend": "cpu", "grasps": 2,
+     "sdf_build_ms": {"median": 1.5}, "solve_us": {"median": 40}, "pass_through": 0}]})";
+  sdfg::bench::ReportRequest request;
+  request.dir = dir / "out";
+  request.resultsJson = json;
+  REQUIRE_FALSE(sdfg::bench::writeReport(request, nullptr).has_value());
+  CHECK(readAll(request.dir / "benchmarks.md").find("## Scenes") == std::string::npos);
+}
+
 TEST_CASE("A broken or missing JSON is an error naming the file", "[bench][report]") {
   const fs::path dir = scratch("broken");
   sdfg::bench::ReportRequest request;

@@ -239,3 +239,36 @@ TEST_CASE("Past the release distance the shown hand returns to tracking, blended
   CHECK_FALSE(r.released);
   CHECK_FALSE(r.constrained);
 }
+
+TEST_CASE("A curled hand swiped at 2 m/s into a 3 mm plate stays on its side",
+          "[core][outer_hand]") {
+  // A vertical plate (its faces at x = +-1.5 mm, its top edge at y = 0), the hand's palm 1 cm below
+  // that edge, fingers curled: they meet the face first.
+  const AnalyticShape plate{ShapeKind::box, glm::vec3(0.0015f, 0.15f, 0.15f)};
+  const Pose worldFromPlate = at(glm::vec3(0.0f, -0.15f, 0.0f));
+  const std::vector<SceneMember> members{{1, nullptr, &plate, worldFromPlate.inverse()}};
+  const SceneExactSource scene(members);
+  for (const float curl : {0.3f, 0.6f, 0.9f}) {
+    CAPTURE(curl);
+    TestHand h(curl);
+    OuterHandOptions o;
+    o.releaseDistance = 1.0f;  // about not passing, not about the release
+    OuterHand outer(h.model, o);
+    const float palmY = h.joints[size_t(Joint::palm)].position.y;
+    float deepest = 0.0f, farthest = -1.0f;
+    for (int k = 0; k < 30; ++k) {
+      OuterHandInput in;
+      in.worldFromWrist = at(glm::vec3(-0.25f + 0.0222f * k, -0.01f - palmY, 0.09f));
+      in.joints = &h.joints;
+      in.radii = &h.radii;
+      in.time = k * kFrame;
+      const auto r = outer.update(in, &scene);
+      REQUIRE(r.ok());
+      const float c = shownClearance(h, *r, plate, worldFromPlate);
+      deepest = std::min(deepest, c);
+      farthest = std::max(farthest, r->worldFromShownWrist.position.x);
+    }
+    CHECK(deepest >= -0.001f);
+    CHECK(farthest < 0.0f);
+  }
+}

@@ -124,6 +124,9 @@ TEST_CASE("Every procedural shape is one closed, outward-wound, valid mesh", "[c
   SECTION("Mug") {
     checkClosedSolid(sdfg::makeMug());
   }
+  SECTION("Spoon") {
+    checkClosedSolid(sdfg::makeSpoon());
+  }
 }
 
 TEST_CASE("Shapes have the topology of what they model", "[core][shapes]") {
@@ -132,6 +135,7 @@ TEST_CASE("Shapes have the topology of what they model", "[core][shapes]") {
   CHECK(eulerCharacteristic(sdfg::makeSphere(1.0f, 2)) == 2);
   CHECK(eulerCharacteristic(sdfg::makeTorus()) == 0);
   CHECK(eulerCharacteristic(sdfg::makeMug()) == 0);
+  CHECK(eulerCharacteristic(sdfg::makeSpoon()) == 2);
 }
 
 TEST_CASE("Shape volumes match the analytic solids", "[core][shapes]") {

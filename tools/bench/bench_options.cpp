@@ -34,6 +34,10 @@ const char* const kUsage =
     "                     surface, open hands inside the mesh kept; adds the table of the whole\n"
     "                     hand's penetration, the hand's motion and contacts, split by whether\n"
     "                     the open hand was already inside\n"
+    "  --scenes           also run every method in scenes: each mesh resting on a table top,\n"
+    "                     two mugs 5 mm apart, a spoon in a mug, a mug's handle 1.5 cm from a\n"
+    "                     wall; the whole hand's penetration into objects not held, grasps of\n"
+    "                     the wrong object, and the single-object figures (--placements each)\n"
     "  --clear-hand on|off  on (default): \"ours\" moves an open hand that is inside the mesh\n"
     "                     out before closing (SolverOptions::clearance); off: as before\n"
     "  --json FILE        write the results as JSON\n"
@@ -60,6 +64,7 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
   app.add_flag("--embedded-only", o.embeddedOnly);
   app.add_flag("--thin-plate-set", o.thinPlateSet);
   app.add_flag("--approaching", o.approaching);
+  app.add_flag("--scenes", o.scenes);
   cli::addRepeatable(app, "--mesh", o.meshes);
   cli::addInteger(app, "--placements", o.placements, 1, 1000000);
   cli::addUnsigned64(app, "--seed", o.seed);

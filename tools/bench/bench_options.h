@@ -23,6 +23,9 @@ struct Options {
   // --approaching: placements from 1 cm inside to 5 cm outside (eval/approaching.h), and the
   // table split by whether the open hand was already inside.
   bool approaching = false;
+  // --scenes: also every method in the scenes of eval/scenes.h (each mesh on a table, objects
+  // beside, inside and near others), figures in the JSON's "scenes" and the report.
+  bool scenes = false;
   bool clearHand = true;  // --clear-hand: "ours" clears the open hand before closing
   int placements = 1000;
   uint64_t seed = 1;

@@ -75,8 +75,11 @@ tools::Json resultsJson(const Options& o, const std::vector<Row>& rows) {
   return out;
 }
 
-bool writeJson(const std::string& file, const Options& o, const std::vector<Row>& rows) {
-  return !tools::writeJsonFile(file, resultsJson(o, rows)).has_value();
+bool writeJson(const std::string& file, const Options& o, const std::vector<Row>& rows,
+               const std::vector<SceneRow>& sceneRows) {
+  tools::Json out = resultsJson(o, rows);
+  if (o.scenes) out["scenes"] = scenesJson(sceneRows);
+  return !tools::writeJsonFile(file, out).has_value();
 }
 
 void printTables(const Options& o, const std::vector<Row>& rows) {

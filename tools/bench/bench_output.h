@@ -8,6 +8,7 @@
 #include "bench_options.h"
 #include "json_file.h"
 #include "run_mesh.h"
+#include "run_scenes.h"
 
 namespace sdfg::bench {
 
@@ -15,7 +16,9 @@ namespace sdfg::bench {
 // build (json_file.h), and one object per row with its figures (null where there are none).
 tools::Json resultsJson(const Options& o, const std::vector<Row>& rows);
 // resultsJson() into `file`; false when it cannot be written.
-bool writeJson(const std::string& file, const Options& o, const std::vector<Row>& rows);
+// With --scenes, `sceneRows` as its "scenes" array (scenesJson()).
+bool writeJson(const std::string& file, const Options& o, const std::vector<Row>& rows,
+               const std::vector<SceneRow>& sceneRows = {});
 void printTables(const Options& o, const std::vector<Row>& rows);
 
 }  // namespace sdfg::bench

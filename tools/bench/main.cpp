@@ -20,6 +20,7 @@
 #include "io/shapes.h"
 #include "report.h"
 #include "run_mesh.h"
+#include "run_scenes.h"
 #include "sdf_backends.h"
 
 using namespace sdfg;
@@ -105,6 +106,9 @@ int main(int argc, char** argv) {
 
   bool failed = false;
   std::vector<Row> rows;
+  // --scenes: each mesh that ran on a table, then the scenes of several objects (embedded ones).
+  std::vector<BenchScene> scenes;
+  bool embeddedRan = false;
   for (const MeshSource& source : sources) {
     TriangleMesh loaded;
     const TriangleMesh* mesh = &source.embedded;
@@ -139,6 +143,12 @@ int main(int argc, char** argv) {
       failed = failed || r.failedSolves > 0;
       rows.push_back(std::move(r));
     }
+    // A file is named with its extension: the shared torus.obj apart from the embedded torus.
+    if (o.scenes) {
+      scenes.push_back(
+          tableScene(source.path ? source.path->filename().string() : source.name, *mesh));
+    }
+    embeddedRan = embeddedRan || !source.path;
     std::fprintf(stderr,
                  "%s: %zu triangles, done in %.1f s (placements + solves %.1f s, grading %.1f s)\n",
                  source.name.c_str(), mesh->triangleCount(),
@@ -147,6 +157,19 @@ int main(int argc, char** argv) {
   }
 
   printTables(o, rows);
+  std::vector<SceneRow> sceneRows;
+  if (o.scenes) {
+    if (embeddedRan) {
+      for (BenchScene& s : objectScenes()) scenes.push_back(std::move(s));
+    }
+    if (useDefaults && !sharedMeshesDir()) {
+      std::fprintf(stderr,
+                   "note: --scenes without ../shared/meshes: the research meshes' table scenes "
+                   "are skipped\n");
+    }
+    sceneRows = runScenes(scenes, o, threads, failed);
+    printSceneTable(sceneRows);
+  }
   if (o.approaching) {
     std::printf(
         "\nApproaching hands (palm 1 cm inside to 5 cm outside), split by whether the "
@@ -154,7 +177,7 @@ int main(int argc, char** argv) {
     printApproachingTable(stdout, rows);
   }
   if (!o.report.empty() && o.json.empty()) o.json = bench::reportResultsPath(o.report).string();
-  if (!o.json.empty() && !writeJson(o.json, o, rows)) {
+  if (!o.json.empty() && !writeJson(o.json, o, rows, sceneRows)) {
     std::fprintf(stderr, "autograsp-bench: cannot write %s\n", o.json.c_str());
     failed = true;
   }

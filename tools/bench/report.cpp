@@ -490,6 +490,7 @@ std::optional<Error> writeReport(const ReportRequest& request, const ScalingResu
     std::fprintf(stderr, "autograsp-bench: %s\n", plotNote.c_str());
     md << "_Note: " << plotNote << "._\n\n";
   }
+  md << scenesSection(*json);
   md << "The data behind the plots: `bench-data/` (the bench's JSON, one `.dat` per figure and "
         "the gnuplot script `plots.gp`).\n";
   if (!notes.empty()) md << "\n<!-- from benchmarks-notes.md -->\n\n" << notes;

@@ -33,6 +33,9 @@ std::string datString(const std::string& s);
 std::string gpString(const std::string& s);
 std::string shellQuote(const std::string& s);
 
+// The report's "Scenes" section from the results JSON ("scenes", --scenes); empty without one.
+std::string scenesSection(const Json& results);
+
 // Markdown tables of the sweep; shared by the console and the report.
 std::string scalingTables(const ScalingResults& r, const std::string& level);
 

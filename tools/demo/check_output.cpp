@@ -3,9 +3,14 @@
 // Per object: <object>-grasp.png is (3 * WIDTH + 8) x WIDTH, each of its three panels holds many
 // colours, the object's blue-grey and the hand's skin tone, and the image has contact magenta;
 // <object>-sdf-slice.png is WIDTH x WIDTH with inside blue, outside red and the black surface.
-// report.md and report.html exist, show every picture, have 15 finger rows per object and no
-// non-finite number, and name the commit of the code that made them. Prints each failed check; exit
-// status 1 when any failed.
+// table-scene.png is 4 panels of WIDTH (4 px apart: the scene, then each of its 3 grasps) with the
+// hand, the objects, the table and contacts in every panel; outer-hand.png is 5 x 2 panels of WIDTH
+// / 2 (4 px apart), the tracked hand grey in the top row and the shown hand in skin tone in the
+// bottom one. report.md and report.html exist, show every picture, have 15 finger rows per object
+// (before the table scene) and no non-finite number, and name the commit of the code that made
+// them; the outer hand's tracked hand goes more than 2 cm into the table and the shown one less
+// than 1 mm. Prints each failed check; exit status 1 when any failed.
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -32,7 +37,8 @@ void check(bool ok, const std::string& what) {
 
 struct Counts {
   std::set<uint32_t> colours;
-  size_t hand = 0, object = 0, magenta = 0, blue = 0, red = 0, black = 0, pixels = 0;
+  size_t hand = 0, object = 0, magenta = 0, blue = 0, red = 0, black = 0, pixels = 0, table = 0,
+         grey = 0;
 };
 
 Counts count(const std::vector<uint8_t>& rgba, uint32_t width, uint32_t x0, uint32_t x1,
@@ -50,6 +56,8 @@ Counts count(const std::vector<uint8_t>& rgba, uint32_t width, uint32_t x0, uint
       if (b > r + 40) ++c.blue;
       if (r > b + 40) ++c.red;
       if (r < 8 && g < 8 && b < 8) ++c.black;
+      if (g > r + 5 && g > b + 10 && g > 60) ++c.table;  // grey-green
+      if (std::abs(r - g) < 6 && b >= g && b - g < 10 && r > 40) ++c.grey;
     }
   }
   return c;
@@ -78,6 +86,76 @@ bool hasNonFinite(const std::string& text) {
   return false;
 }
 
+bool readPicture(const std::string& dir, const std::string& png, uint32_t wantW, uint32_t wantH,
+                 std::vector<uint8_t>& rgba) {
+  uint32_t pw = 0, ph = 0;
+  std::string error;
+  const bool read = sdfg::demo::readPng(dir + "/" + png, pw, ph, rgba, error);
+  check(read, png + " readable " + error);
+  if (!read) return false;
+  const bool sized = pw == wantW && ph == wantH;
+  check(sized, png + " is " + std::to_string(wantW) + "x" + std::to_string(wantH) + " (got " +
+                   std::to_string(pw) + "x" + std::to_string(ph) + ")");
+  return sized;
+}
+
+void checkShown(const std::string& png, const std::string& md, const std::string& html) {
+  check(md.find("(" + png + ")") != std::string::npos, "report.md shows " + png);
+  check(html.find("src=\"" + png + "\"") != std::string::npos, "report.html shows " + png);
+}
+
+void checkScene(const std::string& dir, uint32_t w, const std::string& md,
+                const std::string& html) {
+  const std::string png = "table-scene.png";
+  checkShown(png, md, html);
+  std::vector<uint8_t> rgba;
+  constexpr uint32_t kPanels = 4;
+  if (!readPicture(dir, png, kPanels * w + (kPanels - 1) * 4, w, rgba)) return;
+  for (uint32_t p = 0; p < kPanels; ++p) {
+    const Counts c = count(rgba, kPanels * w + (kPanels - 1) * 4, p * (w + 4), p * (w + 4) + w, w);
+    const std::string name = "table scene panel " + std::to_string(p);
+    check(c.hand > c.pixels / 100, name + ": hand colour on " + std::to_string(c.hand) + " px");
+    check(c.object > c.pixels / 200,
+          name + ": object colour on " + std::to_string(c.object) + " px");
+    check(c.table > c.pixels / 50, name + ": table colour on " + std::to_string(c.table) + " px");
+    check(c.magenta > 0, name + ": contact markers (" + std::to_string(c.magenta) + " px)");
+  }
+}
+
+void checkOuter(const std::string& dir, uint32_t w, const std::string& md,
+                const std::string& html) {
+  const std::string png = "outer-hand.png";
+  checkShown(png, md, html);
+  const uint32_t p = w / 2, totalW = 5 * p + 16, totalH = 2 * p + 4;
+  std::vector<uint8_t> rgba;
+  if (readPicture(dir, png, totalW, totalH, rgba)) {
+    for (uint32_t col = 0; col < 5; ++col) {
+      const uint32_t x0 = col * (p + 4);
+      const Counts top = count(rgba, totalW, x0, x0 + p, p);
+      std::vector<uint8_t> bottomRows(rgba.begin() + size_t(p + 4) * totalW * 4, rgba.end());
+      const Counts bottom = count(bottomRows, totalW, x0, x0 + p, p);
+      const std::string name = "outer hand column " + std::to_string(col);
+      check(top.grey > top.pixels / 200 && top.hand == 0,
+            name + ": tracked hand grey (" + std::to_string(top.grey) + " px), no skin tone");
+      check(bottom.hand > bottom.pixels / 200,
+            name + ": shown hand in skin tone on " + std::to_string(bottom.hand) + " px");
+      check(top.table > top.pixels / 50 && bottom.table > bottom.pixels / 50,
+            name + ": the table in both rows");
+    }
+  }
+  // The point of the outer hand, from the report's own numbers.
+  std::smatch m;
+  const std::regex deepest(
+      "Deepest in the table: tracked hand ([0-9.]+) mm, shown hand ([0-9.]+) mm");
+  const bool found = std::regex_search(md, m, deepest);
+  check(found, "report.md gives the deepest tracked and shown hand");
+  if (found) {
+    const double tracked = std::stod(m[1]), shown = std::stod(m[2]);
+    check(tracked > 20.0, "the tracked hand goes " + m[1].str() + " mm into the table (> 20)");
+    check(shown < 1.0, "the shown hand goes " + m[2].str() + " mm into the table (< 1)");
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -97,7 +175,10 @@ int main(int argc, char** argv) {
   check(std::regex_search(md, commit) && std::regex_search(html, commit),
         "the reports name the commit of the code");
   size_t rows = 0;
-  for (size_t at = md.find("\n| "); at != std::string::npos; at = md.find("\n| ", at + 1)) ++rows;
+  const size_t sceneAt = md.find("\n## Table scene");
+  check(sceneAt != std::string::npos, "report.md has the table scene");
+  check(md.find("\n## Outer hand") != std::string::npos, "report.md has the outer hand");
+  for (size_t at = md.find("\n| "); at < sceneAt; at = md.find("\n| ", at + 1)) ++rows;
   // One header row per object, then 5 fingers x 3 strategies.
   check(rows == objects.size() * 16,
         "report.md: 15 finger rows per object (" + std::to_string(rows) + " table rows)");
@@ -137,6 +218,8 @@ int main(int argc, char** argv) {
             o + " slice: inside blue, outside red, black surface");
     }
   }
+  checkScene(dir, w, md, html);
+  checkOuter(dir, w, md, html);
   std::printf("%s: %d failed checks\n", failures == 0 ? "PASS" : "FAIL", failures);
   return failures == 0 ? 0 : 1;
 }

@@ -2,7 +2,10 @@
 // program) goes through the real Khronos loader, the SDF Autograsp layer and the mock runtime,
 // registers objects with XR_SDFG_auto_grasp, scripts the right controller onto each, squeezes,
 // reads the auto-grasped hand back with xrLocateHandJointsEXT and the grasp state, and renders
-// the result with Vulkan (lavapipe on a machine without a GPU) into PNG files and a report.
+// the result with Vulkan (lavapipe on a machine without a GPU) into PNG files and a report. Then,
+// in this process on the engine the layer runs, a table scene grasped object by object
+// (table_scene.h) and the outer hand keeping a hand out of a table it is pushed into
+// (outer_sequence.h).
 #include <unistd.h>
 
 #include <algorithm>
@@ -25,11 +28,13 @@
 #include "hand/hand_synthesis.h"
 #include "io/mesh_io.h"
 #include "io/shapes.h"
+#include "outer_sequence.h"
 #include "png_io.h"
 #include "renderer.h"
 #include "report.h"
 #include "scene.h"
 #include "sdf/sdf_cpu.h"
+#include "table_scene.h"
 #include "xr_app.h"
 
 namespace fs = std::filesystem;
@@ -57,7 +62,9 @@ void usage(FILE* f) {
       "                      [--resolution N] [--help]\n\n"
       "Grasps objects through OpenXR (Khronos loader, SDF Autograsp layer, mock runtime)\n"
       "with the physics-convex, paper and ours strategies from the same hand placement,\n"
-      "renders them with Vulkan and writes PNG pictures and a report.\n\n"
+      "renders them with Vulkan and writes PNG pictures and a report. Then, with the\n"
+      "engine in this process: a table scene (a mug, a block and a comb on a table top)\n"
+      "grasped, and the outer hand (a hand pushed into a table, tracked and shown).\n\n"
       "  --out DIR         output folder (default out/demo)\n"
       "  --mesh FILE       also grasp this OBJ or PLY file (repeatable); scaled to hand size\n"
       "  --embedded-only   only the built-in mug, torus and thin plate (not %s)\n"
@@ -486,9 +493,39 @@ int main(int argc, char** argv) {
     written.push_back(result.slicePng);
     results.push_back(std::move(result));
   }
+
+  // The table scene and the outer hand: the engine in this process (no OpenXR).
+  progress.step(1, 2, "table scene",
+                "grasping the mug, the block and the comb (GraspSession, ours)");
+  SceneReport sceneReport;
+  TableSceneOptions sceneOptions;
+  sceneOptions.width = opt.width;
+  sceneOptions.supersample = kSupersample;
+  sceneOptions.outDir = opt.out;
+  if (!runTableScene(renderer, sceneOptions, sceneReport, error)) {
+    progress.note("table scene: " + error);
+    info.failures.push_back("table scene: " + error);
+    anyFailure = true;
+  } else {
+    written.push_back(sceneReport.png);
+    for (const auto& g : sceneReport.grasps) anyFailure = anyFailure || !g.ok;
+  }
+  progress.step(2, 2, "outer hand", "a hand pushed into the table (OuterHand)");
+  OuterReport outerReport;
+  OuterSequenceOptions outerOptions;
+  outerOptions.width = opt.width;
+  outerOptions.supersample = kSupersample;
+  outerOptions.outDir = opt.out;
+  if (!runOuterSequence(renderer, outerOptions, outerReport, error)) {
+    progress.note("outer hand: " + error);
+    info.failures.push_back("outer hand: " + error);
+    anyFailure = true;
+  } else {
+    written.push_back(outerReport.png);
+  }
   progress.done();
 
-  if (!writeReports(opt.out, results, info, error)) {
+  if (!writeReports(opt.out, results, sceneReport, outerReport, info, error)) {
     std::fprintf(stderr, "autograsp-demo: %s\n", error.c_str());
     return 2;
   }
@@ -505,6 +542,23 @@ int main(int argc, char** argv) {
     for (const auto& s : r.strategies)
       std::printf("  %s %d/5%s", s.name.c_str(), s.contacts, s.ok ? "" : " (failed)");
     std::printf("\n");
+  }
+  for (const auto& g : sceneReport.grasps) {
+    if (g.ok)
+      std::printf("  table scene: placed on the %s, took the %s, %d/5, %.2f mm into the table\n",
+                  g.aim.c_str(), g.took.c_str(), g.contacts, double(std::max(0.0f, -g.tableMm)));
+    else
+      std::printf("  table scene: placed on the %s: failed: %s\n", g.aim.c_str(), g.error.c_str());
+  }
+  if (!outerReport.frames.empty()) {
+    float tracked = 0.0f, shown = 0.0f;
+    for (const auto& f : outerReport.frames) {
+      tracked = std::min(tracked, f.trackedMm);
+      shown = std::min(shown, f.shownMm);
+    }
+    std::printf("  outer hand: %zu frames, deepest in the table: tracked %.1f mm, shown %.2f mm\n",
+                outerReport.frames.size(), double(std::max(0.0f, -tracked)),
+                double(std::max(0.0f, -shown)));
   }
   for (const auto& f : info.failures) std::printf("  skipped: %s\n", f.c_str());
   std::printf("Pictures (%zu PNG) and the report are in %s/\n", written.size(), dir.c_str());

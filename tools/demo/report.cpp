@@ -1,8 +1,10 @@
 #include "report.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <ostream>
 #include <sstream>
 
 namespace sdfg::demo {
@@ -15,7 +17,9 @@ std::string num(float v, int decimals) {
   if (!std::isfinite(v)) return "-";
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.*f", decimals, double(v));
-  return buf;
+  // A value that rounds to zero is zero, whatever its sign.
+  const std::string s = buf;
+  return s.find_first_not_of("-0.") == std::string::npos && s[0] == '-' ? s.substr(1) : s;
 }
 
 // HTML text from the report's Markdown-style text: escaped, with `code` spans as <code>.
@@ -130,10 +134,108 @@ const char* kExplain =
     "controller pose to clear the open hand before closing it (`XrGraspHandOffsetSDFG`; `ours` "
     "only).";
 
+// A table in both forms: Markdown (the first two columns left-aligned) and HTML.
+void writeTable(std::ostream& md, std::ostream& html, const std::vector<std::string>& head,
+                const std::vector<Row>& body) {
+  md << "|";
+  html << "<div class=\"scroll\"><table><tr>";
+  for (const auto& h : head) {
+    md << " " << h << " |";
+    html << "<th>" << escape(h) << "</th>";
+  }
+  md << "\n|";
+  html << "</tr>\n";
+  for (size_t i = 0; i < head.size(); ++i) md << (i < 2 ? "---|" : "---:|");
+  md << "\n";
+  for (const auto& r : body) {
+    md << "|";
+    html << "<tr>";
+    for (const auto& c : r.cells) {
+      md << " " << c << " |";
+      html << "<td>" << escape(c) << "</td>";
+    }
+    md << "\n";
+    html << "</tr>\n";
+  }
+  md << "\n";
+  html << "</table></div>\n";
+}
+
+std::string depth(float clearanceMm) {
+  return clearanceMm >= 0.0f ? "clear (" + num(clearanceMm, 2) + " mm)"
+                             : num(-clearanceMm, 2) + " mm inside";
+}
+
+void writeScene(std::ostream& md, std::ostream& html, const SceneReport& scene) {
+  md << "## Table scene\n\n" << scene.description << "\n\n";
+  html << "<h2>Table scene</h2>\n<p>" << inlineHtml(scene.description) << "</p>\n";
+  if (scene.png.empty()) {
+    md << "The scene did not run (see above).\n\n";
+    html << "<p class=\"fail\">The scene did not run (see above).</p>\n";
+    return;
+  }
+  md << "![table scene: every grasp, then each close up](" << scene.png << ")\n\n";
+  html << "<p><img src=\"" << scene.png << "\" alt=\"table scene\">\n<span class=\"caption\">"
+       << "left: every grasp; then each close up</span></p>\n<ul>\n";
+  for (const auto& g : scene.grasps) {
+    std::string line = "hand placed on the " + g.aim + ": ";
+    if (!g.ok)
+      line += "failed: " + g.error;
+    else
+      line += "took the " + g.took + ", " + std::to_string(g.contacts) + " fingers in contact (" +
+              std::to_string(g.fingersOnTaken) + " on the " + g.took +
+              "); hand in the table: " + depth(g.tableMm) +
+              "; in the objects: " + depth(g.objectsMm) + "; open hand moved " +
+              num(g.handMovedMm, 1) + " mm; shown " + num(float(g.milliseconds), 0) +
+              " ms after the squeeze";
+    md << "- " << line << "\n";
+    html << "<li>" << inlineHtml(line) << "</li>\n";
+  }
+  md << "\n";
+  html << "</ul>\n";
+  std::vector<Row> body;
+  for (const auto& g : scene.grasps)
+    for (int f = 0; f < 5 && g.ok; ++f)
+      body.push_back({{g.aim, kFingers[f], num(g.curl[size_t(f)], 3), g.touched[size_t(f)]}});
+  writeTable(md, html, {"placed on", "finger", "curl", "touches"}, body);
+}
+
+void writeOuter(std::ostream& md, std::ostream& html, const OuterReport& outer) {
+  md << "## Outer hand\n\n" << outer.description << "\n\n";
+  html << "<h2>Outer hand</h2>\n<p>" << inlineHtml(outer.description) << "</p>\n";
+  if (outer.png.empty()) {
+    md << "The sequence did not run (see above).\n\n";
+    html << "<p class=\"fail\">The sequence did not run (see above).</p>\n";
+    return;
+  }
+  float deepTracked = 0.0f, deepShown = 0.0f;
+  for (const auto& f : outer.frames) {
+    deepTracked = std::min(deepTracked, f.trackedMm);
+    deepShown = std::min(deepShown, f.shownMm);
+  }
+  const std::string line = "Deepest in the table: tracked hand " +
+                           num(std::max(0.0f, -deepTracked), 1) + " mm, shown hand " +
+                           num(std::max(0.0f, -deepShown), 2) + " mm.";
+  md << "![outer hand: tracked (top) and shown (bottom)](" << outer.png << ")\n\n"
+     << line << "\n\n";
+  html << "<p><img src=\"" << outer.png << "\" alt=\"outer hand\">\n<span class=\"caption\">"
+       << "top: tracked hand; bottom: shown hand</span></p>\n<p>" << escape(line) << "</p>\n";
+  std::vector<Row> body;
+  for (const auto& f : outer.frames)
+    body.push_back(
+        {{std::to_string(f.frame) + (f.pictured ? " (pictured)" : ""), f.phase, num(f.trackedMm, 2),
+          num(f.shownMm, 2), num(f.offsetMm, 1), f.constrained ? "yes" : "no"}});
+  writeTable(md, html,
+             {"frame", "phase", "tracked clearance (mm)", "shown clearance (mm)",
+              "shown wrist off tracked (mm)", "constrained"},
+             body);
+}
+
 }  // namespace
 
 bool writeReports(const std::string& dir, const std::vector<ObjectResult>& objects,
-                  const ReportInfo& info, std::string& error) {
+                  const SceneReport& scene, const OuterReport& outer, const ReportInfo& info,
+                  std::string& error) {
   std::ofstream md(dir + "/report.md");
   std::ofstream html(dir + "/report.html");
   if (!md || !html) {
@@ -163,8 +265,8 @@ bool writeReports(const std::string& dir, const std::vector<ObjectResult>& objec
        << "; " << escape(info.environment) << "; panel width " << info.width << " px.</p>\n"
        << "<p>Code: git commit " << escape(info.commit) << ".</p>\n";
   if (!info.failures.empty()) {
-    md << "## Meshes skipped\n\n";
-    html << "<h2>Meshes skipped</h2><ul>\n";
+    md << "## Skipped\n\n";
+    html << "<h2>Skipped</h2><ul>\n";
     for (const auto& f : info.failures) {
       md << "- " << f << "\n";
       html << "<li class=\"fail\">" << escape(f) << "</li>\n";
@@ -186,29 +288,12 @@ bool writeReports(const std::string& dir, const std::vector<ObjectResult>& objec
       md << "- " << summaryLine(s) << "\n";
       html << "<li>" << inlineHtml(summaryLine(s)) << "</li>\n";
     }
-    md << "\n|";
-    html << "</ul>\n<div class=\"scroll\"><table><tr>";
-    for (const auto& h : header()) {
-      md << " " << h << " |";
-      html << "<th>" << escape(h) << "</th>";
-    }
-    md << "\n|";
-    html << "</tr>\n";
-    for (size_t i = 0; i < header().size(); ++i) md << (i < 2 ? "---|" : "---:|");
     md << "\n";
-    for (const auto& r : rows(o)) {
-      md << "|";
-      html << "<tr>";
-      for (const auto& c : r.cells) {
-        md << " " << c << " |";
-        html << "<td>" << escape(c) << "</td>";
-      }
-      md << "\n";
-      html << "</tr>\n";
-    }
-    md << "\n";
-    html << "</table></div>\n";
+    html << "</ul>\n";
+    writeTable(md, html, header(), rows(o));
   }
+  writeScene(md, html, scene);
+  writeOuter(md, html, outer);
   html << "</body></html>\n";
   if (!md || !html) {
     error = dir + ": writing the report failed";

@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <random>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat3x3.hpp>
 
+#include "grasp/hand_clearance.h"
 #include "hand/hand_synthesis.h"
 
 namespace sdfg::demo {
@@ -136,16 +139,21 @@ glm::mat4 graspCamera(const HandPose& hand, const Aabb& objectBounds, float aspe
   // In front of the fingers, from the thumb side and a little below the palm: the fingers wrap
   // toward the camera and the object stays visible between them.
   const glm::vec3 toCamera = glm::normalize(-0.6f * hx - 0.3f * hy - 1.0f * hz);
+  return lookCamera(centre, radius, toCamera, hy, aspect, lightOut);
+}
+
+glm::mat4 lookCamera(const glm::vec3& centre, float radius, const glm::vec3& toCamera,
+                     const glm::vec3& up, float aspect, glm::vec3& lightOut) {
   const float fov = glm::radians(35.0f);
   // The bounding sphere of a box is loose: come closer than it asks.
   const float distance = radius / std::sin(fov * 0.5f) * 0.78f;
   const glm::vec3 eye = centre + toCamera * distance;
-  const glm::vec3 up = glm::normalize(hy - glm::dot(hy, toCamera) * toCamera);
-  const glm::mat4 view = glm::lookAtRH(eye, centre, up);
+  const glm::vec3 u = glm::normalize(up - glm::dot(up, toCamera) * toCamera);
+  const glm::mat4 view = glm::lookAtRH(eye, centre, u);
   glm::mat4 proj = glm::perspectiveRH_ZO(fov, aspect, distance * 0.05f, distance * 4.0f);
   proj[1][1] *= -1.0f;  // Vulkan's y points down
-  const glm::vec3 right = glm::normalize(glm::cross(-toCamera, up));
-  lightOut = glm::normalize(toCamera + 0.8f * up - 0.4f * right);
+  const glm::vec3 right = glm::normalize(glm::cross(-toCamera, u));
+  lightOut = glm::normalize(toCamera + 0.8f * u - 0.4f * right);
   return proj * view;
 }
 
@@ -294,6 +302,48 @@ std::vector<uint8_t> downsample(const std::vector<uint8_t>& rgba, uint32_t width
     }
   }
   return out;
+}
+
+HandPose modelHand(const HandModel& model, const std::array<JointCurls, kFingerCount>& curls,
+                   const Pose& worldFromWrist) {
+  JointPoses poses;
+  JointRadii radii;
+  placeJoints(model, FingerCurls{}, worldFromWrist, poses, radii);
+  replaceFingers(model, curls, {true, true, true, true, true}, worldFromWrist, poses);
+  HandPose hand;
+  for (int k = 0; k < kJointCount; ++k) {
+    hand.positions[size_t(k)] = poses[size_t(k)].position;
+    hand.radii[size_t(k)] = radii[size_t(k)];
+  }
+  hand.worldFromWrist = worldFromWrist;
+  return hand;
+}
+
+float leastClearance(const HandPose& hand, const std::function<float(const glm::vec3&)>& distance) {
+  JointPoses joints{};
+  for (int k = 0; k < kJointCount; ++k) joints[size_t(k)].position = hand.positions[size_t(k)];
+  HandParts parts;
+  const int n = jointParts(joints, hand.radii, parts);
+  float least = std::numeric_limits<float>::infinity();
+  for (int i = 0; i < n; ++i)
+    least = std::min(least, distance(parts[size_t(i)].centre) - parts[size_t(i)].radius);
+  return least;
+}
+
+bool renderPanel(Renderer& renderer, const DrawList& list, const glm::mat4& viewProjection,
+                 const glm::vec3& light, uint32_t width, uint32_t height, uint32_t supersample,
+                 std::vector<uint8_t>& picture, uint32_t pictureWidth, uint32_t x0, uint32_t y0,
+                 std::string& error) {
+  std::vector<uint8_t> big;
+  if (!renderer.render(list, viewProjection, light, width * supersample, height * supersample,
+                       kBackground, big, error))
+    return false;
+  const std::vector<uint8_t> small =
+      downsample(big, width * supersample, height * supersample, supersample);
+  for (uint32_t y = 0; y < height; ++y)
+    std::memcpy(&picture[(size_t(y0 + y) * pictureWidth + x0) * 4], &small[size_t(y) * width * 4],
+                size_t(width) * 4);
+  return true;
 }
 
 }  // namespace sdfg::demo

@@ -15,6 +15,12 @@
 // shown; its length is the grab latency in frames), held (still), held moving (30 degrees over 60
 // frames about the object's vertical axis), held deforming (vertices rescaled every frame).
 //
+// The outer-hand scenario ("outer", issue 27): no grab; the open hand is held 5 mm above a table
+// beside four blocks (near), then pressed 2 cm into the table and slid along it into the blocks
+// (touching), so the outer hand (on by default in the layer) runs in every frame and moves the
+// hand in the touching phase. --room N registers N targets in all, the rest spread over a room
+// (issue 26's scale: 1000 targets, the hand's 5 among them).
+//
 // Options: kUsage below (--help prints it).
 #include <openxr/openxr.h>
 
@@ -46,6 +52,7 @@
 #include "io/mesh_io.h"
 #include "io/shapes.h"
 #include "mock_runtime_test.h"
+#include "outer_scene.h"
 #include "results.h"
 #include "sdf/sdf_grid.h"
 
@@ -58,10 +65,14 @@ using namespace std::chrono_literals;
 constexpr auto kFramePeriod = std::chrono::nanoseconds(11'111'111);  // 90 Hz
 
 const char* const kUsage =
-    "usage: autograsp-frame-cost [--frames N] [--embedded-only] [--only NAME]... [--json FILE]\n"
+    "usage: autograsp-frame-cost [--frames N] [--embedded-only] [--only NAME]... [--room N]\n"
+    "                            [--json FILE]\n"
     "  --frames N       frames per phase (default 60, at least 2; the smoke test uses a few)\n"
     "  --embedded-only  skip ../shared/meshes (the bunny and the armadillos)\n"
-    "  --only NAME      measure only the object called NAME (repeatable)\n"
+    "  --only NAME      measure only the object called NAME (repeatable); \"outer\" names the\n"
+    "                   outer-hand scenario\n"
+    "  --room N         the outer-hand scenario registers N targets (default 5, at least 5): 5 in\n"
+    "                   the hand's box, the rest spread over a 10 x 10 m room\n"
     "  --json FILE      write the results as JSON (without it nothing is written)\n"
     "  --help           this text\n"
     "exit codes: 0 every object measured; 1 an object failed or the JSON could not be written;\n"
@@ -70,12 +81,6 @@ const char* const kUsage =
 double ms(Clock::duration d) {
   return std::chrono::duration<double, std::milli>(d).count();
 }
-
-struct Object {
-  std::string name;
-  std::vector<XrVector3f> vertices;
-  std::vector<uint32_t> indices;
-};
 
 // Centred at the origin and scaled so its largest extent is `extent` metres (the armadillos are
 // in millimetres; every object becomes hand-sized).
@@ -226,6 +231,24 @@ class App {
     return r == XR_SUCCESS;
   }
 
+  // Creates one more target (timed), kept until the session ends. False on refusal.
+  bool addTarget(const Object& o, const XrPosef& pose, double& callMs) {
+    XrGraspTargetVerticesSDFG v{XR_TYPE_GRASP_TARGET_VERTICES_SDFG};
+    v.vertexCount = uint32_t(o.vertices.size());
+    v.vertices = o.vertices.data();
+    v.indexCount = uint32_t(o.indices.size());
+    v.indices = o.indices.data();
+    XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &v};
+    ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, local_, pose};
+    XrGraspTargetSDFG handle = XR_NULL_HANDLE;
+    const auto t0 = Clock::now();
+    const XrResult r = createTarget_(session_, &ci, &handle);
+    callMs = ms(Clock::now() - t0);
+    if (r != XR_SUCCESS) return false;
+    others_.push_back(handle);
+    return true;
+  }
+
   // One frame, paced to 90 Hz; `before` runs first (the app's own updates of the target, timed
   // as part of the frame). Returns the app's time in OpenXR calls (ms); fills calls[name].
   template <class F>
@@ -263,12 +286,17 @@ class App {
         timed("xrLocateHandJointsEXT", [&] { locate_(trackers_[h], &info, &locations); });
       }
       XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
-      XrGraspBuildInfoSDFG build{XR_TYPE_GRASP_BUILD_INFO_SDFG};
+      XrGraspHandOffsetSDFG offset{XR_TYPE_GRASP_HAND_OFFSET_SDFG};
+      XrGraspBuildInfoSDFG build{XR_TYPE_GRASP_BUILD_INFO_SDFG, &offset};
       XrGraspTargetsSetupInfoSDFG setup{XR_TYPE_GRASP_TARGETS_SETUP_INFO_SDFG, &build};
       XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG, &setup};
       timed("xrGetGraspStateSDFG", [&] { state_(session_, &gi, &st); });
       grasping_ = st.isGrasping == XR_TRUE;
       ready_ = setup.readyCount > 0;
+      readyCount_ = setup.readyCount;
+      const XrPosef& o = offset.offset;
+      handMoved_ = o.position.x != 0.0f || o.position.y != 0.0f || o.position.z != 0.0f ||
+                   o.orientation.x != 0.0f || o.orientation.y != 0.0f || o.orientation.z != 0.0f;
       cpuBuilds_ = build.cpuBuildCount;
     }
     XrFrameEndInfo ei{XR_TYPE_FRAME_END_INFO};
@@ -299,6 +327,9 @@ class App {
 
   bool grasping() const { return grasping_; }
   bool ready() const { return ready_; }
+  uint32_t readyCount() const { return readyCount_; }
+  // The frame's XrGraspHandOffsetSDFG::offset (right hand) was not the identity.
+  bool handMoved() const { return handMoved_; }
   uint64_t cpuBuilds() const { return cpuBuilds_; }
   uint64_t framesEnded() const { return framesEnded_; }
   bool layer() const { return layer_; }
@@ -341,7 +372,10 @@ class App {
   uint64_t framesEnded_ = 0;
   bool grasping_ = false;
   bool ready_ = false;
-  uint64_t cpuBuilds_ = 0;  // the session's CPU builds so far (XrGraspBuildInfoSDFG)
+  uint32_t readyCount_ = 0;
+  bool handMoved_ = false;
+  std::vector<XrGraspTargetSDFG> others_;  // addTarget()'s
+  uint64_t cpuBuilds_ = 0;                 // the session's CPU builds so far (XrGraspBuildInfoSDFG)
   XrGraspTargetSDFG target_ = XR_NULL_HANDLE;
   std::array<XrHandTrackerEXT, 2> trackers_{};
   std::array<XrHandJointLocationEXT, XR_HAND_JOINT_COUNT_EXT> joints_{};
@@ -467,10 +501,71 @@ RunResult run(const Object& object, bool layer, int phaseFrames) {
   return out;
 }
 
+// `outerHand`: the layer's outer_hand setting (through its environment variable).
+OuterRun runOuter(const OuterScene& scene, bool layer, bool outerHand, int phaseFrames) {
+  OuterRun out;
+  setLayer(layer);
+  if (outerHand)
+    unsetenv("SDFG_AUTOGRASP_OUTER_HAND");
+  else
+    setenv("SDFG_AUTOGRASP_OUTER_HAND", "off", 1);
+  App app(layer);
+  if (!app.init(out.error)) return out;
+  auto none = [] { return 0.0; };
+  std::map<std::string, std::vector<double>> ignored;
+  if (!app.script(gripLine(0, scene.grip) + squeezeLine(0, 0.0f))) {
+    out.error = "the script was refused";
+    return out;
+  }
+  if (layer) {
+    const auto t0 = Clock::now();
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+      double call = 0;
+      if (!app.addTarget(scene.objects[i], scene.poses[i], call)) {
+        out.error = "xrCreateGraspTargetSDFG refused target " + std::to_string(i);
+        return out;
+      }
+      out.createTotalMs += call;
+      out.createMaxMs = std::max(out.createMaxMs, call);
+    }
+    // The set-ups run on the layer's worker; frames go on meanwhile (at most 120 s).
+    while (app.readyCount() < scene.objects.size() && Clock::now() - t0 < 120s)
+      app.frame(ignored, none);
+    out.setupMs = ms(Clock::now() - t0);
+    if (app.readyCount() < scene.objects.size()) {
+      out.error = std::to_string(app.readyCount()) + " of " + std::to_string(scene.objects.size()) +
+                  " targets ready after 120 s";
+      return out;
+    }
+  } else {
+    app.frame(ignored, none);
+  }
+  // Near: the open hand held 5 mm above the table, beside the blocks.
+  for (int i = 0; i < phaseFrames; ++i) {
+    out.frameMs[0].push_back(app.frame(out.callMs, none));
+    out.movedFrames[0] += app.handMoved();
+  }
+  // Touching: pressed into the table and sliding along it, into the blocks at the ends.
+  const uint64_t s = app.framesEnded();
+  std::string script = gripLine(0, scene.grip) + squeezeLine(0, 0.0f);
+  for (int i = 0; i < phaseFrames; ++i)
+    script += gripLine(s + uint64_t(i), touchingGrip(scene, i, phaseFrames));
+  if (!app.script(script)) {
+    out.error = "the touching script was refused";
+    return out;
+  }
+  for (int i = 0; i < phaseFrames; ++i) {
+    out.frameMs[1].push_back(app.frame(out.callMs, none));
+    out.movedFrames[1] += app.handMoved();
+  }
+  out.ok = true;
+  return out;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
   int phaseFrames = 60;
+  int room = 5;
   bool embeddedOnly = false, help = false;
   std::string json;
   std::vector<std::string> onlyNames;
@@ -481,6 +576,7 @@ int main(int argc, char** argv) {
       cli, "--frames", std::numeric_limits<int>::min(), std::numeric_limits<int>::max(),
       [&](long long n) { phaseFrames = std::max(2, int(n)); }, "an integer");
   cli.add_flag("--embedded-only", embeddedOnly);
+  sdfg::tools::cli::addInteger(cli, "--room", room, 5, 100000);
   sdfg::tools::cli::addName(cli, "--json", json, "file name");
   sdfg::tools::cli::addRepeatable(cli, "--only", onlyNames);
   if (auto error = sdfg::tools::cli::parse(cli, argc, argv)) {
@@ -547,31 +643,96 @@ int main(int argc, char** argv) {
     results.push_back(std::move(r));
   }
 
-  std::printf(
-      "\nTime the layer adds to the app's OpenXR calls per frame (ms; layer on minus the "
-      "layer-off median of the phase), 90 Hz pacing, %d frames per phase; code at commit %s\n\n",
-      phaseFrames, sdfg::tools::describeBuild().c_str());
-  std::printf("| object | triangles | create call | set-up | grab latency (frames) |");
-  for (const char* p : kPhases) std::printf(" %s p50 / p99 / max |", p);
-  std::printf("\n|---|---:|---:|---:|---:|");
-  for (int p = 0; p < kPhaseCount; ++p) std::printf("---|");
-  std::printf("\n");
   int failures = 0;
-  for (const MeshResult& r : results) {
-    if (!r.ok) {
-      std::printf("| %s | %zu | failed: %s |\n", r.name.c_str(), r.triangles, r.error.c_str());
-      ++failures;
-      continue;
-    }
-    std::printf("| %s | %zu | %.3f ms | %.0f ms | %d |", r.name.c_str(), r.triangles, r.on.createMs,
-                r.on.setupMs, r.on.grabLatencyFrames);
-    for (const Percentiles& a : r.added) std::printf(" %.3f / %.3f / %.3f |", a.p50, a.p99, a.max);
+  // The objects' table, unless only the outer-hand scenario ran.
+  if (!results.empty() || !skipped.empty()) {
+    std::printf(
+        "\nTime the layer adds to the app's OpenXR calls per frame (ms; layer on minus the "
+        "layer-off median of the phase), 90 Hz pacing, %d frames per phase; code at commit %s\n\n",
+        phaseFrames, sdfg::tools::describeBuild().c_str());
+    std::printf("| object | triangles | create call | set-up | grab latency (frames) |");
+    for (const char* p : kPhases) std::printf(" %s p50 / p99 / max |", p);
+    std::printf("\n|---|---:|---:|---:|---:|");
+    for (int p = 0; p < kPhaseCount; ++p) std::printf("---|");
     std::printf("\n");
+    for (const MeshResult& r : results) {
+      if (!r.ok) {
+        std::printf("| %s | %zu | failed: %s |\n", r.name.c_str(), r.triangles, r.error.c_str());
+        ++failures;
+        continue;
+      }
+      std::printf("| %s | %zu | %.3f ms | %.0f ms | %d |", r.name.c_str(), r.triangles,
+                  r.on.createMs, r.on.setupMs, r.on.grabLatencyFrames);
+      for (const Percentiles& a : r.added)
+        std::printf(" %.3f / %.3f / %.3f |", a.p50, a.p99, a.max);
+      std::printf("\n");
+    }
+    for (const std::string& s : skipped) std::printf("| %s | skipped: not found |\n", s.c_str());
   }
-  for (const std::string& s : skipped) std::printf("| %s | skipped: not found |\n", s.c_str());
+
+  std::optional<OuterResult> outer;
+  if (only.empty() || only.count("outer") != 0) {
+    const OuterScene scene = outerScene(room);
+    OuterResult r;
+    r.targets = int(scene.objects.size());
+    r.inHandBox = scene.inHandBox;
+    std::printf("\nouter (%d targets, %d in the hand's box): layer off...", r.targets, r.inHandBox);
+    std::fflush(stdout);
+    r.off = runOuter(scene, false, true, phaseFrames);
+    std::printf(" on...");
+    std::fflush(stdout);
+    r.on = runOuter(scene, true, true, phaseFrames);
+    std::printf(" on without the outer hand...");
+    std::fflush(stdout);
+    r.onWithoutOuter = runOuter(scene, true, false, phaseFrames);
+    unsetenv("SDFG_AUTOGRASP_OUTER_HAND");
+    std::printf(" done\n");
+    r.ok = r.off.ok && r.on.ok && r.onWithoutOuter.ok;
+    r.error = !r.off.ok              ? "layer off: " + r.off.error
+              : !r.on.ok             ? "layer on: " + r.on.error
+              : !r.onWithoutOuter.ok ? "outer hand off: " + r.onWithoutOuter.error
+                                     : "";
+    for (int p = 0; p < kOuterPhaseCount; ++p) {
+      r.offStats[p] = percentiles(r.off.frameMs[p]);
+      r.offMedian[p] = r.offStats[p].p50;
+      std::vector<double> added;
+      for (double v : r.on.frameMs[p]) added.push_back(v - r.offMedian[p]);
+      r.added[p] = percentiles(added);
+      added.clear();
+      for (double v : r.onWithoutOuter.frameMs[p]) added.push_back(v - r.offMedian[p]);
+      r.addedWithoutOuter[p] = percentiles(added);
+    }
+    std::printf(
+        "\nThe outer hand: time the layer adds per frame (ms), open hand near, then pressed into "
+        "and sliding along, the targets in its box; code at commit %s\n\n",
+        sdfg::tools::describeBuild().c_str());
+    std::printf(
+        "| layer | targets | in hand box | create calls total / max | set-up | near p50 / p99 / "
+        "max | "
+        "touching p50 / p99 / max | frames the hand was moved (near, touching) |\n"
+        "|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    if (!r.ok) {
+      std::printf("| on | %d | %d | failed: %s |\n", r.targets, r.inHandBox, r.error.c_str());
+      ++failures;
+    } else {
+      auto row = [&](const char* what, const OuterRun& run,
+                     const std::array<Percentiles, kOuterPhaseCount>& added) {
+        std::printf("| %s | %d | %d | %.1f / %.3f ms | %.0f ms |", what, r.targets, r.inHandBox,
+                    run.createTotalMs, run.createMaxMs, run.setupMs);
+        for (const Percentiles& a : added)
+          std::printf(" %.3f / %.3f / %.3f |", a.p50, a.p99, a.max);
+        std::printf(" %d of %zu, %d of %zu |\n", run.movedFrames[0], run.frameMs[0].size(),
+                    run.movedFrames[1], run.frameMs[1].size());
+      };
+      row("on", r.on, r.added);
+      row("on, outer hand off", r.onWithoutOuter, r.addedWithoutOuter);
+    }
+    outer = std::move(r);
+  }
   if (!json.empty()) {
-    if (auto error = sdfg::tools::writeJsonFile(
-            json, resultsJson(results, phaseFrames, ms(kFramePeriod), skipped))) {
+    if (auto error =
+            sdfg::tools::writeJsonFile(json, resultsJson(results, phaseFrames, ms(kFramePeriod),
+                                                         skipped, outer ? &*outer : nullptr))) {
       std::fprintf(stderr, "autograsp-frame-cost: %s\n", error->message.c_str());
       return 1;
     }

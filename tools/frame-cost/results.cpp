@@ -22,7 +22,8 @@ Percentiles percentiles(std::vector<double> v) {
 }
 
 tools::Json resultsJson(const std::vector<MeshResult>& results, int phaseFrames,
-                        double framePeriodMs, const std::vector<std::string>& skipped) {
+                        double framePeriodMs, const std::vector<std::string>& skipped,
+                        const OuterResult* outer) {
   using tools::Json;
   using tools::jsonNumber;
   Json out;
@@ -63,6 +64,42 @@ tools::Json resultsJson(const std::vector<MeshResult>& results, int phaseFrames,
                      {"max_ms", jsonNumber(c.max)}};
     }
     meshes.push_back(std::move(m));
+  }
+  if (outer != nullptr) {
+    const OuterResult& r = *outer;
+    Json o;
+    o["targets"] = r.targets;
+    o["in_hand_box"] = r.inHandBox;
+    o["ok"] = r.ok;
+    o["error"] = r.error;
+    o["create_calls_total_ms"] = jsonNumber(r.on.createTotalMs);
+    o["create_call_max_ms"] = jsonNumber(r.on.createMaxMs);
+    o["setup_ms"] = jsonNumber(r.on.setupMs);
+    Json& phases = o["phases"] = Json::object();
+    for (int p = 0; p < kOuterPhaseCount; ++p) {
+      const Percentiles& a = r.added[p];
+      phases[kOuterPhases[p]] = {
+          {"frames", a.count},
+          {"added_p50_ms", jsonNumber(a.p50)},
+          {"added_p99_ms", jsonNumber(a.p99)},
+          {"added_max_ms", jsonNumber(a.max)},
+          {"off_median_ms", jsonNumber(r.offMedian[p])},
+          {"off_p99_ms", jsonNumber(r.offStats[p].p99)},
+          {"off_max_ms", jsonNumber(r.offStats[p].max)},
+          {"hand_moved_frames", r.on.movedFrames[p]},
+          {"outer_hand_off_added_p50_ms", jsonNumber(r.addedWithoutOuter[p].p50)},
+          {"outer_hand_off_added_p99_ms", jsonNumber(r.addedWithoutOuter[p].p99)},
+          {"outer_hand_off_added_max_ms", jsonNumber(r.addedWithoutOuter[p].max)},
+          {"outer_hand_off_hand_moved_frames", r.onWithoutOuter.movedFrames[p]}};
+    }
+    Json& calls = o["calls_on"] = Json::object();
+    for (const auto& [name, v] : r.on.callMs) {
+      const Percentiles c = percentiles(v);
+      calls[name] = {{"p50_ms", jsonNumber(c.p50)},
+                     {"p99_ms", jsonNumber(c.p99)},
+                     {"max_ms", jsonNumber(c.max)}};
+    }
+    out["outer"] = std::move(o);
   }
   return out;
 }

@@ -54,10 +54,42 @@ struct MeshResult {
   std::array<Percentiles, kPhaseCount> offStats;  // the layer-off run's own frame totals
 };
 
+// The outer-hand scenario (issue 27): the hand near, then pressed into and sliding along, the
+// targets in its grab box, among `targets` registered in all (--room N: the rest spread over a
+// room, away from the hand).
+inline constexpr int kOuterPhaseCount = 2;
+inline constexpr const char* kOuterPhases[kOuterPhaseCount] = {"near", "touching"};
+
+struct OuterRun {
+  bool ok = false;
+  std::string error;
+  std::array<std::vector<double>, kOuterPhaseCount> frameMs;
+  std::map<std::string, std::vector<double>> callMs;
+  // Frames whose XrGraspHandOffsetSDFG::offset moved the hand (the outer hand at work).
+  std::array<int, kOuterPhaseCount> movedFrames{};
+  double createTotalMs = 0;  // every xrCreateGraspTargetSDFG call
+  double createMaxMs = 0;    // the slowest one
+  double setupMs = 0;        // from the first create until every target is ready
+};
+
+struct OuterResult {
+  int targets = 0;    // registered in all
+  int inHandBox = 0;  // of them, in the hand's grab box
+  bool ok = false;
+  std::string error;
+  // Layer on (its defaults: the outer hand on), layer off, and layer on with the outer hand
+  // switched off (its configuration's outer_hand): the outer hand's own share.
+  OuterRun on, off, onWithoutOuter;
+  std::array<Percentiles, kOuterPhaseCount> added, addedWithoutOuter;
+  std::array<double, kOuterPhaseCount> offMedian{};
+  std::array<Percentiles, kOuterPhaseCount> offStats;
+};
+
 // The results as JSON: the settings, the provenance of the build (json_file.h), the objects
 // skipped (not found or unreadable), and per object its calls, set-up, grab latency and, per
-// phase, the time added per frame.
+// phase, the time added per frame; with `outer`, the outer-hand scenario as "outer".
 tools::Json resultsJson(const std::vector<MeshResult>& results, int phaseFrames,
-                        double framePeriodMs, const std::vector<std::string>& skipped);
+                        double framePeriodMs, const std::vector<std::string>& skipped,
+                        const OuterResult* outer = nullptr);
 
 }  // namespace sdfg::frame_cost

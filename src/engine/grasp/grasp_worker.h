@@ -41,6 +41,7 @@
 #include <vector>
 
 #include "base/pose.h"
+#include "base/published.h"
 #include "base/status.h"
 #include "grasp/contact.h"
 #include "grasp/hand_clearance.h"
@@ -178,11 +179,11 @@ class GraspWorker {
     std::array<float, kJointCount> radii{};
     float attachedReach = 0.0f;
   };
-  // The newest finished outer-hand result of a slot, published by the worker and read without a
-  // lock from any thread (the layer's xrLocateHandJointsEXT draws with a result that finished
-  // after the update that asked for it).
+  // The newest finished outer-hand result of a slot, published by the worker and read from any
+  // thread without waiting for the worker's work (the layer's xrLocateHandJointsEXT draws with a
+  // result that finished after the update that asked for it).
   struct OuterMailbox {
-    std::atomic<std::shared_ptr<const OuterDone>> latest;
+    Published<OuterDone> latest;
   };
 
   // `backend`: the CPU grab-box builder the worker uses (one thread is the session's default:

@@ -21,6 +21,8 @@ constexpr float kLever = 0.1f;  // metres
 constexpr int kDualSweeps = 100;
 constexpr int kMaxFingerSteps = 64;
 constexpr float kMinCurlStep = 1e-4f;
+// A finger freed from inside stops trying a way once it is this much deeper than its best.
+constexpr float kWrongWay = 0.002f;  // metres
 // Finger spheres whose clearance bound is this far above a contact are not searched again.
 constexpr float kFingerSlack = 0.003f;  // metres
 // Spheres along a finger's bones are at most this many of the smaller joint radius apart.
@@ -623,14 +625,33 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
     bool contact = false;
     float g =
         clearanceAt(a, rig.speed * std::abs(target - a) + options_.margin + kActiveBand, kInf);
-    // Inside where it starts (the scene moved, or the rigid part could not take it along):
-    // open it until it is clear, or as far as it goes.
-    for (int k = 0; k < kMaxFingerSteps && g < options_.margin && a > 0.0f; ++k) {
-      const float b = std::max(0.0f, a - std::max(options_.margin - g, 0.0005f) / rig.speed);
-      advance(a, b);
-      a = b;
-      g = clearanceAt(a, options_.margin + kActiveBand, near);
+    // Inside where it starts (the scene moved, or the rigid part could not take it along): the
+    // curl nearest it that is clear, or failing that the least deep, opening or closing (opening
+    // is not always the way out: a finger curled over a plate's face swings into it as it opens).
+    if (g < 0.0f) {
+      float bestA = a, bestG = g;
+      for (const float way : {-1.0f, 1.0f}) {
+        float c = a;
+        fingerProbe.reset(rig.t.size());
+        float gc = clearanceAt(c, options_.margin + kActiveBand, kInf);
+        for (int k = 0; k < kMaxFingerSteps && gc < options_.margin; ++k) {
+          const float step = std::max(options_.margin - gc, 0.0005f) / rig.speed;
+          const float d = std::clamp(c + way * step, 0.0f, 1.0f);
+          if (d == c) break;
+          advance(c, d);
+          c = d;
+          gc = clearanceAt(c, options_.margin + kActiveBand, near);
+          if (gc > bestG) bestA = c, bestG = gc;
+          if (gc < bestG - kWrongWay) break;  // deeper this way
+        }
+        if (bestG >= options_.margin) break;
+      }
+      a = bestA;
+      fingerProbe.reset(rig.t.size());
+      g = clearanceAt(a, options_.margin + kActiveBand, kInf);
       contact = true;
+    } else if (g < options_.margin) {
+      contact = true;  // on the surface where it starts: stays there
     }
     const float dir = target >= a ? 1.0f : -1.0f;
     for (int k = 0; k < kMaxFingerSteps && !contact; ++k) {

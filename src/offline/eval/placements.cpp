@@ -64,6 +64,14 @@ std::vector<Placement> generatePlacements(const TriangleMesh& normalizedMesh,
                                           const ExactMeshQuery& query, const HandModel& hand,
                                           const GridBox& box, int count, uint64_t seed,
                                           PlacementStats* stats) {
+  return generatePlacements(normalizedMesh, query, hand, box, count, seed, nullptr, stats);
+}
+
+std::vector<Placement> generatePlacements(const TriangleMesh& normalizedMesh,
+                                          const ExactMeshQuery& query, const HandModel& hand,
+                                          const GridBox& box, int count, uint64_t seed,
+                                          const std::function<bool(const Pose&)>& alsoRejects,
+                                          PlacementStats* stats) {
   PlacementStats local;
   PlacementStats& st = stats ? *stats : local;
   st = PlacementStats{};
@@ -131,7 +139,8 @@ std::vector<Placement> generatePlacements(const TriangleMesh& normalizedMesh,
       ++st.outsideBox;
       continue;
     }
-    if (openHandIntersects(query, hand, objectFromHand)) {
+    if (openHandIntersects(query, hand, objectFromHand) ||
+        (alsoRejects && alsoRejects(objectFromHand))) {
       ++st.handIntersecting;
       continue;
     }

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -53,6 +54,16 @@ struct PlacementStats {
 std::vector<Placement> generatePlacements(const TriangleMesh& normalizedMesh,
                                           const ExactMeshQuery& query, const HandModel& hand,
                                           const GridBox& box, int count, uint64_t seed,
+                                          PlacementStats* stats = nullptr);
+
+// The same, where the open hand must also keep clear of other solids around the mesh (a scene: a
+// table, a wall, another object): an attempt is also rejected, counted as handIntersecting, when
+// `alsoRejects(objectFromHand)` is true. It is asked only after the tests above passed, so the
+// random numbers drawn, and the placements kept for a null one, are those of generatePlacements().
+std::vector<Placement> generatePlacements(const TriangleMesh& normalizedMesh,
+                                          const ExactMeshQuery& query, const HandModel& hand,
+                                          const GridBox& box, int count, uint64_t seed,
+                                          const std::function<bool(const Pose&)>& alsoRejects,
                                           PlacementStats* stats = nullptr);
 
 // Whether the open hand at `objectFromHand` touches or enters the mesh (the rejection test above,

@@ -23,62 +23,84 @@ btDefaultCollisionConstructionInfo smallPools() {
 }  // namespace
 
 struct PhysicsCollider::Impl {
-  // Arrays the triangle-mesh shape references (btTriangleIndexVertexArray does not copy).
-  std::vector<btScalar> vertices;  // xyz per vertex
-  std::vector<int> indices;        // three per triangle
-  std::unique_ptr<btTriangleIndexVertexArray> meshInterface;
-  std::unique_ptr<btCollisionShape> shape;
+  // One static object per part, each with the arrays its triangle-mesh shape references
+  // (btTriangleIndexVertexArray does not copy).
+  struct Part {
+    std::vector<btScalar> vertices;  // xyz per vertex
+    std::vector<int> indices;        // three per triangle
+    std::unique_ptr<btTriangleIndexVertexArray> meshInterface;
+    std::unique_ptr<btCollisionShape> shape;
+    btCollisionObject object;
+  };
+  std::vector<std::unique_ptr<Part>> parts;
   // Declared in construction order; destroyed in reverse, the world before what it uses.
   btDefaultCollisionConfiguration configuration{smallPools()};
   btCollisionDispatcher dispatcher{&configuration};
   btDbvtBroadphase broadphase;
   btCollisionWorld world{&dispatcher, &broadphase, &configuration};
-  btCollisionObject object;
 };
 
 PhysicsCollider::PhysicsCollider(Kind kind) : kind_(kind), impl_(std::make_unique<Impl>()) {}
 
 PhysicsCollider::~PhysicsCollider() {
-  if (impl_) impl_->world.removeCollisionObject(&impl_->object);
+  if (!impl_) return;
+  for (auto& part : impl_->parts) impl_->world.removeCollisionObject(&part->object);
 }
 
 size_t PhysicsCollider::shapeVertexCount() const {
-  if (kind_ == Kind::convexHull) {
-    return size_t(static_cast<const btConvexHullShape*>(impl_->shape.get())->getNumPoints());
+  size_t count = 0;
+  for (const auto& part : impl_->parts) {
+    count += kind_ == Kind::convexHull
+                 ? size_t(static_cast<const btConvexHullShape*>(part->shape.get())->getNumPoints())
+                 : part->vertices.size() / 3;
   }
-  return impl_->vertices.size() / 3;
+  return count;
 }
 
 Result<std::unique_ptr<PhysicsCollider>> PhysicsCollider::create(const TriangleMesh& mesh,
                                                                  Kind kind) {
-  if (auto error = validateMesh(mesh.positions, mesh.indices)) {
-    return makeError(error->code, "physics collider: " + error->message);
+  return create(std::span<const TriangleMesh>(&mesh, 1), kind);
+}
+
+Result<std::unique_ptr<PhysicsCollider>> PhysicsCollider::create(
+    std::span<const TriangleMesh> meshes, Kind kind) {
+  if (meshes.empty()) {
+    return makeError(Status::invalid_argument, "physics collider: no mesh");
+  }
+  for (const TriangleMesh& mesh : meshes) {
+    if (auto error = validateMesh(mesh.positions, mesh.indices)) {
+      return makeError(error->code, "physics collider: " + error->message);
+    }
   }
   std::unique_ptr<PhysicsCollider> collider(new PhysicsCollider(kind));
   Impl& impl = *collider->impl_;
-  if (kind == Kind::convexHull) {
-    auto hull = std::make_unique<btConvexHullShape>();
-    for (const glm::vec3& p : mesh.positions) hull->addPoint(btVector3(p.x, p.y, p.z), false);
-    hull->optimizeConvexHull();  // keeps the exact hull's vertices only: cheaper support queries
-    hull->setMargin(0);
-    hull->recalcLocalAabb();
-    impl.shape = std::move(hull);
-  } else {
-    impl.vertices.reserve(mesh.positions.size() * 3);
-    for (const glm::vec3& p : mesh.positions) {
-      impl.vertices.insert(impl.vertices.end(), {btScalar(p.x), btScalar(p.y), btScalar(p.z)});
+  for (const TriangleMesh& mesh : meshes) {
+    auto part = std::make_unique<Impl::Part>();
+    if (kind == Kind::convexHull) {
+      auto hull = std::make_unique<btConvexHullShape>();
+      for (const glm::vec3& p : mesh.positions) hull->addPoint(btVector3(p.x, p.y, p.z), false);
+      hull->optimizeConvexHull();  // keeps the exact hull's vertices only: cheaper support queries
+      hull->setMargin(0);
+      hull->recalcLocalAabb();
+      part->shape = std::move(hull);
+    } else {
+      part->vertices.reserve(mesh.positions.size() * 3);
+      for (const glm::vec3& p : mesh.positions) {
+        part->vertices.insert(part->vertices.end(), {btScalar(p.x), btScalar(p.y), btScalar(p.z)});
+      }
+      part->indices.assign(mesh.indices.begin(), mesh.indices.end());
+      part->meshInterface = std::make_unique<btTriangleIndexVertexArray>(
+          int(mesh.triangleCount()), part->indices.data(), int(3 * sizeof(int)),
+          int(mesh.vertexCount()), part->vertices.data(), int(3 * sizeof(btScalar)));
+      auto shape = std::make_unique<btBvhTriangleMeshShape>(part->meshInterface.get(), true);
+      shape->setMargin(0);
+      part->shape = std::move(shape);
     }
-    impl.indices.assign(mesh.indices.begin(), mesh.indices.end());
-    impl.meshInterface = std::make_unique<btTriangleIndexVertexArray>(
-        int(mesh.triangleCount()), impl.indices.data(), int(3 * sizeof(int)),
-        int(mesh.vertexCount()), impl.vertices.data(), int(3 * sizeof(btScalar)));
-    auto shape = std::make_unique<btBvhTriangleMeshShape>(impl.meshInterface.get(), true);
-    shape->setMargin(0);
-    impl.shape = std::move(shape);
+    part->object.setCollisionShape(part->shape.get());
+    part->object.setWorldTransform(btTransform::getIdentity());
+    impl.world.addCollisionObject(&part->object);
+    impl.parts.push_back(std::move(part));
   }
-  impl.object.setCollisionShape(impl.shape.get());
-  impl.object.setWorldTransform(btTransform::getIdentity());
-  impl.world.addCollisionObject(&impl.object);
   impl.world.updateAabbs();
   return collider;
 }

@@ -15,6 +15,7 @@
 
 #include <array>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -26,7 +27,7 @@
 
 namespace sdfg {
 
-// A Bullet collision world holding one static object, in the object's own space.
+// A Bullet collision world holding static objects (usually one), in the object's own space.
 // Not thread-safe: queries reuse Bullet's dispatcher, so use one collider per thread.
 class PhysicsCollider {
  public:
@@ -44,6 +45,11 @@ class PhysicsCollider {
   // Builds a collider from a mesh (copied). invalid_argument on a mesh validateMesh() rejects
   // (empty, bad indices, NaN...).
   static Result<std::unique_ptr<PhysicsCollider>> create(const TriangleMesh& mesh, Kind kind);
+  // A collider of several objects (a scene, every part in the same space), each its own shape of
+  // `kind`: one convex hull per object, not the hull of them all. invalid_argument on an empty
+  // span or any mesh validateMesh() rejects.
+  static Result<std::unique_ptr<PhysicsCollider>> create(std::span<const TriangleMesh> meshes,
+                                                         Kind kind);
 
   ~PhysicsCollider();
   PhysicsCollider(const PhysicsCollider&) = delete;

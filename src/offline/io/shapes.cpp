@@ -259,6 +259,46 @@ TriangleMesh makeSphere(float radius, int subdivisions) {
   return mesh;
 }
 
+TriangleMesh makeSpoon(float length) {
+  constexpr int kRings = 60;         // cross-sections between the two poles
+  constexpr int kSides = 16;         // vertices per cross-section
+  constexpr float kBowlEnd = 0.36f;  // fraction of the length the bowl takes
+  // Half width and half thickness at fraction s of the length: the larger of the bowl's swell
+  // and the handle's constant section, the handle rounded off over its last tenth.
+  auto section = [](float s) {
+    const float bowl =
+        s < kBowlEnd ? std::sqrt(std::max(0.0f, std::sin(kPi * s / kBowlEnd))) : 0.0f;
+    const float end =
+        s > 0.9f ? std::sqrt(std::max(0.0f, 1.0f - ((s - 0.9f) / 0.1f) * ((s - 0.9f) / 0.1f)))
+                 : 1.0f;
+    return glm::vec2(std::max(0.017f * bowl, 0.0055f * end),
+                     std::max(0.005f * bowl, 0.0022f * end));
+  };
+  TriangleMesh mesh;
+  mesh.positions.emplace_back(0.0f, 0.0f, 0.0f);  // pole at the bowl's tip
+  for (int i = 1; i <= kRings; ++i) {
+    const float s = float(i) / float(kRings + 1);
+    const glm::vec2 half = section(s);
+    for (int j = 0; j < kSides; ++j) {
+      const float phi = 2.0f * kPi * float(j) / float(kSides);
+      mesh.positions.emplace_back(s * length, half.y * std::sin(phi), half.x * std::cos(phi));
+    }
+  }
+  const uint32_t tip = 0, end = uint32_t(mesh.positions.size());
+  mesh.positions.emplace_back(length, 0.0f, 0.0f);  // pole at the handle's end
+  auto id = [](int ring, int side) { return uint32_t(1 + (ring - 1) * kSides + side % kSides); };
+  // Stepping j turns from +Z towards +Y and stepping the ring goes along +X, so (ring, j) ->
+  // (ring + 1, j) -> (ring + 1, j + 1) is counter-clockwise seen from outside.
+  for (int j = 0; j < kSides; ++j) {
+    mesh.indices.insert(mesh.indices.end(), {tip, id(1, j), id(1, j + 1)});
+    for (int i = 1; i < kRings; ++i) {
+      addQuad(mesh.indices, id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+    }
+    mesh.indices.insert(mesh.indices.end(), {end, id(kRings, j + 1), id(kRings, j)});
+  }
+  return mesh;
+}
+
 std::vector<NamedMesh> embeddedObjects() {
   std::vector<NamedMesh> objects;
   objects.push_back({"mug", makeMug()});

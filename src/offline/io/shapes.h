@@ -34,6 +34,13 @@ TriangleMesh makeBox(const glm::vec3& extent);
 // 20 * 4^subdivisions triangles; subdivisions is clamped to [0, 7].
 TriangleMesh makeSphere(float radius, int subdivisions = 3);
 
+// A spoon: one closed genus-0 loft along +X, from the bowl's tip at x = 0 to the handle's end at
+// x = `length`. The cross-sections are ellipses (width along Z, thickness along Y): a bowl 3.4 cm
+// wide and 1 cm thick over the first 36 % of the length, narrowing to a handle 1.1 cm wide and
+// 4.4 mm thick. The bowl is solid (no cavity): the benchmark's scenes need a long, thin graspable
+// part beside another object, not the hollow of the bowl.
+TriangleMesh makeSpoon(float length = 0.15f);
+
 struct NamedMesh {
   std::string name;
   TriangleMesh mesh;

@@ -1,0 +1,86 @@
+// A strategy's grasps in a scene (eval/scenes.h): what the whole hand does to the objects it does
+// not hold, whether it took the object the palm faces, and the single-object figures on the
+// object it holds. Deterministic for a seed, so the quality tests gate it and the benchmark
+// publishes it.
+//
+// Per placement (open hand clear of every object, palm facing a surface point of the object
+// reached for, 1 to 4 cm off it: eval/placements.h with the other objects added to the
+// rejection), each strategy closes the hand as it would in an app:
+//  - "ours": through the engine's GraspWorker, exactly as the layer's session runs it: every
+//    object a target (scene geometry as analytic shape targets of role scene), the union field of
+//    all of them, the scene's exact distance, and the target the closing hand touches
+//    (grasp/target_choice.h);
+//  - "physics-convex", "physics-mesh": one Bullet world with a collider per object (a convex hull
+//    each, or the triangles); the hand takes the graspable object most touching fingertips are on
+//    (nearest surface to each contact), ties to the one nearest the palm;
+//  - "paper": it sees one target by design: the graspable object whose bounding box is nearest
+//    the palm (the rule before scenes), its field alone; it takes it when a finger stopped.
+// Then, against the exact meshes (eval/evaluator.h, CGAL, independent of what the solvers read):
+//  - the whole hand's penetration (eval/approaching.h: palm and every bone, where the strategy
+//    moved the hand) into every object it does not hold, the deepest per grasp;
+//  - the object the palm faces: the first surface a ray from the palm joint along the palm's
+//    normal meets (sphere tracing on the exact distances, up to 30 cm); a grasp is "wrong" when
+//    that object is graspable and the hand took another graspable object;
+//  - evaluateGrasp() on the object held (or, holding nothing, the one reached for): contacts,
+//    residuals, finger penetration, early stops, pass-throughs, as the single-object benchmark,
+//    except that what a finger does is judged on every object (evaluateGrasp() on each): its
+//    contact residual and touching on the nearest object, a pass-through through any object, and
+//    an early stop only where no other object is within the early-stop gap either.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "base/status.h"
+#include "eval/scenes.h"
+#include "grasp/solver.h"
+#include "sdf/sdf_grid.h"
+
+namespace sdfg {
+
+struct SceneRun {
+  std::string method = "ours";  // any strategy of createAnySolver()
+  int placements = 100;
+  uint64_t seed = 1;
+  unsigned threads = 1;  // grading threads; no effect on the figures
+  SolverOptions options{};
+  bool exactCheck = true;  // "ours": the scene's exact distance (GraspSettings::exactCheck)
+  GridBox box = GridBox::referenceDefault();
+};
+
+struct SceneFigures {
+  int grasps = 0;
+  // The whole hand inside objects it does not hold, per grasp's deepest (mm).
+  double otherPenetrationP99Mm = 0.0;
+  double otherPenetrationMaxMm = 0.0;
+  int deepestPlacement = -1;  // the grasp with the deepest (-1: none inside anything)
+  std::string deepestObject;  // the object it is in
+  int otherPenetrating = 0;   // grasps with any part inside an object not held
+  int facingGraspable = 0;    // grasps whose palm faces a graspable object
+  int wrongObject = 0;        // of those, the hand took another graspable object
+  int heldNothing = 0;        // of those, the hand took nothing
+  int firstWrongPlacement = -1;
+  // Over the wrong grasps: fingers in contact on the object taken and on the one faced (each
+  // contact point's nearest object), summed.
+  int wrongFingersOnTaken = 0;
+  int wrongFingersOnFaced = 0;
+  // The wrong grasps where some finger in contact was on the object faced: a rule that took the
+  // faced object whenever a finger touches it would have taken it there.
+  int wrongWithFingerOnFaced = 0;
+  // Single-object figures on the object held (else the one reached for).
+  double contactsPerGrasp = 0.0;  // fingers touching it (within kTouchingMm), mean
+  int fingersInContact = 0;
+  double contactResidualMedianMm = 0.0;
+  double contactResidualP95Mm = 0.0;
+  double penetrationP99Mm = 0.0;  // fingers into it, per grasp's deepest
+  double penetrationMaxMm = 0.0;
+  int earlyStops = 0;
+  int passThroughs = 0;
+};
+
+// Errors: an unknown strategy, invalid options, fewer placements found than asked, or a failed
+// build or solve (named).
+Result<SceneFigures> measureScene(const BenchScene& scene, const SceneRun& run);
+
+}  // namespace sdfg

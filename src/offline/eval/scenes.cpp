@@ -1,0 +1,121 @@
+#include "eval/scenes.h"
+
+#include <cmath>
+#include <numbers>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "eval/quality.h"
+#include "io/shapes.h"
+
+namespace sdfg {
+
+namespace {
+
+constexpr glm::vec3 kTableHalf{0.25f, 0.02f, 0.25f};
+// The mug of shapes.h: centred on its origin, 9.5 cm tall, handle on +X reaching x = 7.35 cm.
+constexpr float kMugHalfHeight = 0.0475f;
+constexpr float kMugRadius = 0.04f;
+constexpr float kMugHandleReach = 0.0735f;
+constexpr float kMugGap = 0.005f;   // between the two mugs
+constexpr float kWallGap = 0.015f;  // from the handle's end to the wall
+constexpr float kWallHalfThickness = 0.01f;
+
+SceneObject boxObject(const std::string& name, const glm::vec3& half, const glm::vec3& centre) {
+  SceneObject o;
+  o.name = name;
+  o.mesh = makeBox(2.0f * half);
+  o.shape = AnalyticShape{ShapeKind::box, half};
+  o.worldFromObject.position = centre;
+  o.graspable = false;
+  return o;
+}
+
+SceneObject mugAt(const std::string& name, const glm::vec3& floorCentre, float turnY) {
+  SceneObject o;
+  o.name = name;
+  o.mesh = makeMug();
+  o.worldFromObject = Pose{glm::angleAxis(turnY, glm::vec3(0, 1, 0)),
+                           floorCentre + glm::vec3(0.0f, kMugHalfHeight, 0.0f)};
+  return o;
+}
+
+}  // namespace
+
+SceneObject makeTable() {
+  return boxObject("table", kTableHalf, glm::vec3(0.0f, -kTableHalf.y, 0.0f));
+}
+
+BenchScene tableScene(const std::string& name, const TriangleMesh& mesh) {
+  BenchScene scene;
+  scene.name = name + "/table";
+  scene.description = name + " (scaled to the benchmark's size) resting on a table top";
+  SceneObject object;
+  object.name = name;
+  object.mesh = normalizedToDiagonal(mesh, kBenchObjectDiagonal);
+  const Aabb bounds = computeBounds(object.mesh.positions);
+  object.worldFromObject.position = glm::vec3(0.0f, -bounds.min.y, 0.0f);
+  scene.objects.push_back(std::move(object));
+  scene.objects.push_back(makeTable());
+  scene.reachedFor = 0;
+  return scene;
+}
+
+std::vector<BenchScene> objectScenes() {
+  std::vector<BenchScene> scenes;
+  {
+    BenchScene s;
+    s.name = "mug-beside-mug";
+    s.description =
+        "two mugs 5 mm apart on a table, both graspable (the second turned, handle away); the "
+        "hand reaches for the first";
+    s.objects.push_back(mugAt("mug", glm::vec3(0.0f), 0.0f));
+    // Turned half a turn, the second mug's body ends at x = centre + radius.
+    const float centre = -kMugRadius - kMugGap - kMugRadius;
+    s.objects.push_back(mugAt("mug-2", glm::vec3(centre, 0.0f, 0.0f), std::numbers::pi_v<float>));
+    s.objects.push_back(makeTable());
+    scenes.push_back(std::move(s));
+  }
+  {
+    BenchScene s;
+    s.name = "spoon-in-mug";
+    s.description =
+        "a 15 cm spoon standing slanted in a mug (bowl near the floor, handle out over the rim), "
+        "both graspable; the hand reaches for the spoon";
+    s.objects.push_back(mugAt("mug", glm::vec3(0.0f), 0.0f));
+    SceneObject spoon;
+    spoon.name = "spoon";
+    spoon.mesh = makeSpoon(0.15f);
+    // The bowl's tip 1.25 cm above the mug's inner floor, the handle leaning 21 degrees off the
+    // axis towards +X: it clears the wall by more than a centimetre all the way up to the rim.
+    const glm::vec3 direction = glm::normalize(glm::vec3(0.05f, 0.13f, 0.0f));
+    spoon.worldFromObject =
+        Pose{glm::angleAxis(std::atan2(direction.y, direction.x), glm::vec3(0, 0, 1)),
+             glm::vec3(-0.02f, kMugHalfHeight - 0.035f, 0.0f)};
+    s.objects.push_back(std::move(spoon));
+    s.objects.push_back(makeTable());
+    s.reachedFor = 1;
+    scenes.push_back(std::move(s));
+  }
+  {
+    BenchScene s;
+    s.name = "mug-handle-wall";
+    s.description = "a mug on a table whose handle ends 1.5 cm from a wall (2 cm thick)";
+    s.objects.push_back(mugAt("mug", glm::vec3(0.0f), 0.0f));
+    s.objects.push_back(
+        boxObject("wall", glm::vec3(kWallHalfThickness, 0.15f, kTableHalf.z),
+                  glm::vec3(kMugHandleReach + kWallGap + kWallHalfThickness, 0.15f, 0.0f)));
+    s.objects.push_back(makeTable());
+    scenes.push_back(std::move(s));
+  }
+  return scenes;
+}
+
+std::vector<BenchScene> embeddedScenes() {
+  std::vector<BenchScene> scenes;
+  for (const NamedMesh& m : embeddedObjects()) scenes.push_back(tableScene(m.name, m.mesh));
+  for (BenchScene& s : objectScenes()) scenes.push_back(std::move(s));
+  return scenes;
+}
+
+}  // namespace sdfg

@@ -1,0 +1,310 @@
+#include "trajectories.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "grasp/hand_clearance.h"
+#include "io/shapes.h"
+
+namespace sdfg::outer_bench {
+namespace {
+
+constexpr float kPi = 3.14159265f;
+
+// Frames of linear motion and holds, 90 Hz.
+class Path {
+ public:
+  explicit Path(const Pose& start) { frames_.push_back(start); }
+  void moveTo(const Pose& to, float speed) {
+    const Pose from = frames_.back();
+    const float d = glm::length(to.position - from.position);
+    const int n = std::max(1, int(std::ceil(d / (speed * float(kFrameSeconds)))));
+    for (int i = 1; i <= n; ++i) {
+      const float t = float(i) / float(n);
+      frames_.push_back(Pose{glm::slerp(from.orientation, to.orientation, t),
+                             from.position + (to.position - from.position) * t});
+    }
+  }
+  void hold(double seconds) {
+    const int n = std::max(1, int(std::lround(seconds / kFrameSeconds)));
+    for (int i = 0; i < n; ++i) frames_.push_back(frames_.back());
+  }
+  // Turns the hand about the world Y axis through `centre` from its angle now by `radians`, at
+  // `radiansPerSecond`.
+  void orbit(const glm::vec3& centre, float radians, float radiansPerSecond) {
+    const Pose from = frames_.back();
+    const int n =
+        std::max(1, int(std::ceil(std::abs(radians) / (radiansPerSecond * float(kFrameSeconds)))));
+    for (int i = 1; i <= n; ++i) {
+      const glm::quat q = glm::angleAxis(radians * float(i) / float(n), glm::vec3(0, 1, 0));
+      frames_.push_back(Pose{q * from.orientation, centre + q * (from.position - centre)});
+    }
+  }
+  const Pose& last() const { return frames_.back(); }
+  std::vector<Pose> take() { return std::move(frames_); }
+
+ private:
+  std::vector<Pose> frames_;
+};
+
+Pose moved(const Pose& p, const glm::vec3& by) {
+  return Pose{p.orientation, p.position + by};
+}
+
+// The offset along `dir` (unit) from `base` at which the tracked hand first touches the objects:
+// steps of 0.5 mm (no thin part is skipped), then bisection to 1 micrometre. `base` must be clear
+// and the hand must touch within `reach`.
+float touchOffset(const TrackedHand& hand, const std::vector<SceneObject>& objects,
+                  const Pose& base, const glm::vec3& dir, float reach) {
+  JointPoses j;
+  auto clearance = [&](float s) {
+    hand.world(moved(base, dir * s), j);
+    return smallestClearance(j, hand.radii, objects);
+  };
+  if (!(clearance(0.0f) > 0.0f))
+    throw std::logic_error("a trajectory's approach does not start clear");
+  float lo = 0.0f, hi = 0.0f;
+  for (hi = 0.0005f; hi <= reach && clearance(hi) > 0.0f; hi += 0.0005f) lo = hi;
+  if (hi > reach) throw std::logic_error("a trajectory's approach touches nothing");
+  while (hi - lo > 1e-6f) {
+    const float mid = 0.5f * (lo + hi);
+    (clearance(mid) > 0.0f ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+SceneObject table() {
+  SceneObject o;
+  o.name = "table";
+  o.id = 1;
+  o.role = TargetRole::scene;  // stop only: hands rest on it and never take it
+  o.shape = AnalyticShape{ShapeKind::box, glm::vec3(0.6f, 0.02f, 0.6f)};
+  o.worldFromObject = Pose{glm::quat(1, 0, 0, 0), glm::vec3(0.0f, -0.02f, 0.0f)};  // top at y = 0
+  return o;
+}
+
+SceneObject meshObject(const std::string& name, uint64_t id, TriangleMesh mesh, const Pose& at) {
+  SceneObject o;
+  o.name = name;
+  o.id = id;
+  o.worldFromObject = at;
+  o.mesh = std::make_shared<const TriangleMesh>(std::move(mesh));
+  auto d = MeshDistance::create(*o.mesh);
+  if (!d) throw std::runtime_error(name + ": " + d.error().message);
+  o.distance = std::shared_ptr<const MeshDistance>(std::move(*d));
+  return o;
+}
+
+Pose at(const glm::quat& q, const glm::vec3& p) {
+  return Pose{q, p};
+}
+
+}  // namespace
+
+float SceneObject::signedDistance(const glm::vec3& world) const {
+  const glm::vec3 p = worldFromObject.inverse().transformPoint(world);
+  return shape ? shape->signedDistance(p) : distance->signedDistance(p);
+}
+
+TrackedHand::TrackedHand(float curl) {
+  FingerCurls c;
+  c.fill(curl);
+  model.pose(c, local);
+  for (int j = 0; j < kJointCount; ++j) radii[size_t(j)] = model.jointRadius(Joint(j));
+}
+
+void TrackedHand::world(const Pose& worldFromHand, JointPoses& out) const {
+  for (int j = 0; j < kJointCount; ++j) out[size_t(j)] = worldFromHand * local[size_t(j)];
+}
+
+float smallestClearance(const JointPoses& joints, const std::array<float, kJointCount>& radii,
+                        const std::vector<SceneObject>& objects) {
+  float c = std::numeric_limits<float>::infinity();
+  for (const SceneObject& o : objects)
+    for (int j = 0; j < kJointCount; ++j)
+      c = std::min(c, o.signedDistance(joints[size_t(j)].position) - radii[size_t(j)]);
+  return c;
+}
+
+float smallestPartClearance(const JointPoses& joints, const std::array<float, kJointCount>& radii,
+                            const std::vector<SceneObject>& objects, bool cover) {
+  HandParts parts;
+  const int n = jointParts(joints, radii, parts);
+  float c = std::numeric_limits<float>::infinity();
+  for (const SceneObject& o : objects)
+    for (int i = 0; i < n; ++i)
+      c = std::min(c, o.signedDistance(parts[size_t(i)].centre) -
+                          (cover ? parts[size_t(i)].coverRadius : parts[size_t(i)].radius));
+  return c;
+}
+
+std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale) {
+  const glm::vec3 down(0, -1, 0), east(1, 0, 0);
+  const glm::quat flat(1, 0, 0, 0);  // palm down, fingers toward -Z
+  const glm::quat palmEast = glm::angleAxis(0.5f * kPi, glm::vec3(0, 0, 1));  // palm toward +X
+  auto secs = [&](double s) { return s * double(scale); };
+  std::vector<Trajectory> out;
+
+  // 1. Into the table 2 cm past its surface, then along it.
+  {
+    Trajectory t;
+    t.name = "table_slide";
+    t.description = "reach 2 cm into a table (box, scene role) at 0.5 m/s, slide 20 cm + 10 cm";
+    t.objects.push_back(table());
+    const Pose base = at(flat, glm::vec3(0.0f, 0.15f, 0.09f));
+    const float touch = touchOffset(hand, t.objects, base, down, 0.3f);
+    Path p(moved(base, down * (touch - 0.10f)));
+    p.hold(secs(0.2));
+    p.moveTo(moved(base, down * (touch + 0.02f)), 0.5f);
+    p.hold(secs(0.2));
+    p.moveTo(moved(p.last(), east * 0.2f * scale), 0.3f);
+    p.moveTo(moved(p.last(), glm::vec3(0, 0, -0.1f * scale)), 0.3f);
+    p.hold(secs(0.2));
+    p.moveTo(moved(p.last(), -down * 0.12f), 0.5f);
+    p.hold(secs(0.3));
+    t.hand = p.take();
+    out.push_back(std::move(t));
+  }
+
+  // 2. Through a 3 mm plate at 2, 3 and 5 m/s (6 cm past its touch: inside the release distance).
+  for (float speed : {2.0f, 3.0f, 5.0f}) {
+    Trajectory t;
+    t.name = "plate_push_" + std::to_string(int(speed)) + "ms";
+    t.description = "palm first through a 3 mm plate (30 x 30 cm mesh) to 6 cm past its touch";
+    t.objects.push_back(meshObject("plate", 2, makeThinPlate(0.30f, 0.30f, 0.003f), Pose{}));
+    t.pass = PassCheck{Pose{}, 0.0015f, glm::vec2(0.15f, 0.15f)};
+    const Pose base = at(flat, glm::vec3(0.0f, 0.15f, 0.09f));
+    const float touch = touchOffset(hand, t.objects, base, down, 0.3f);
+    const Pose start = moved(base, down * (touch - 0.10f));
+    Path p(start);
+    p.hold(secs(0.2));
+    p.moveTo(moved(base, down * (touch + 0.06f)), speed);
+    p.hold(secs(0.2));
+    p.moveTo(start, speed);
+    p.hold(secs(0.3));
+    t.hand = p.take();
+    out.push_back(std::move(t));
+  }
+
+  // 3. Along the mug 2 cm inside its wall: the palm faces its axis and the hand circles it.
+  {
+    Trajectory t;
+    t.name = "mug_slide";
+    t.description = "palm 2 cm inside the mug's wall, circling it +-60 degrees at 1.5 rad/s";
+    t.objects.push_back(meshObject("mug", 4, makeMug(), Pose{}));
+    const glm::vec3 palm = palmEast * hand.local[size_t(Joint::palm)].position;
+    const Pose base = at(palmEast, glm::vec3(-0.25f, -palm.y, -palm.z));
+    const float touch = touchOffset(hand, t.objects, base, east, 0.3f);
+    const Pose start = moved(base, east * (touch - 0.10f));
+    Path p(start);
+    p.hold(secs(0.2));
+    p.moveTo(moved(base, east * (touch + 0.02f)), 0.5f);
+    p.hold(secs(0.2));
+    const float turn = glm::radians(60.0f) * scale;
+    p.orbit(glm::vec3(0.0f), -turn, 1.5f);
+    p.orbit(glm::vec3(0.0f), 2.0f * turn, 1.5f);
+    p.orbit(glm::vec3(0.0f), -turn, 1.5f);
+    p.hold(secs(0.2));
+    p.moveTo(start, 0.5f);
+    p.hold(secs(0.3));
+    t.hand = p.take();
+    out.push_back(std::move(t));
+  }
+
+  // 4. Fast swipes through thin parts (2, 3 and 5 m/s): a ring 1 cm thick, and an upright plate
+  // 1 cm below its top edge.
+  for (float speed : {2.0f, 3.0f, 5.0f}) {
+    Trajectory t;
+    t.name = "ring_swipe_" + std::to_string(int(speed)) + "ms";
+    t.description = "palm first into a torus ring (tube 1 cm across) to 6 cm past its touch";
+    t.objects.push_back(meshObject("ring", 3, makeTorus(0.06f, 0.005f, 96, 16), Pose{}));
+    // Middle finger's intermediate joint at the tube's height and at z = 0 (its nearest point).
+    const glm::vec3 mid = palmEast * hand.local[size_t(Joint::middle_intermediate)].position;
+    const Pose base = at(palmEast, glm::vec3(-0.25f, -mid.y, -mid.z));
+    // The check's +Y is the world's -X (the hand comes from -X).
+    t.pass =
+        PassCheck{at(palmEast, glm::vec3(-0.06f, 0.0f, 0.0f)), 0.005f, glm::vec2(0.005f, 0.01f)};
+    const float touch = touchOffset(hand, t.objects, base, east, 0.3f);
+    const Pose start = moved(base, east * (touch - 0.10f));
+    Path p(start);
+    p.hold(secs(0.2));
+    p.moveTo(moved(base, east * (touch + 0.06f)), speed);
+    p.hold(secs(0.1));
+    p.moveTo(start, speed);
+    p.hold(secs(0.3));
+    t.hand = p.take();
+    out.push_back(std::move(t));
+  }
+  for (float speed : {2.0f, 3.0f, 5.0f}) {
+    Trajectory t;
+    t.name = "plate_edge_" + std::to_string(int(speed)) + "ms";
+    t.description = "side of the flat hand into an upright 3 mm plate 1 cm below its top edge";
+    // Upright: the plate's thin axis (its Y) along the world's -X, its top edge at y = 0.
+    const Pose worldFromPlate = at(palmEast, glm::vec3(0.0f, -0.15f, 0.0f));
+    t.objects.push_back(
+        meshObject("plate", 2, makeThinPlate(0.30f, 0.30f, 0.003f), worldFromPlate));
+    t.pass = PassCheck{worldFromPlate, 0.0015f, glm::vec2(0.15f, 0.15f)};
+    const glm::vec3 palm = hand.local[size_t(Joint::palm)].position;
+    const Pose base = at(flat, glm::vec3(-0.30f, -0.01f - palm.y, 0.09f));
+    const float touch = touchOffset(hand, t.objects, base, east, 0.4f);
+    const Pose start = moved(base, east * (touch - 0.10f));
+    Path p(start);
+    p.hold(secs(0.2));
+    p.moveTo(moved(base, east * (touch + 0.06f)), speed);
+    p.hold(secs(0.1));
+    p.moveTo(start, speed);
+    p.hold(secs(0.3));
+    t.hand = p.take();
+    out.push_back(std::move(t));
+  }
+
+  // 5. Still hands: 3 mm above the table (near, clear), and pressed 1 cm into the table and the
+  // mug.
+  {
+    Trajectory t;
+    t.name = "table_near_still";
+    t.description = "held still 3 mm above a table for 2 s";
+    t.objects.push_back(table());
+    const Pose base = at(flat, glm::vec3(0.0f, 0.15f, 0.09f));
+    const float touch = touchOffset(hand, t.objects, base, down, 0.3f);
+    Path p(moved(base, down * (touch - 0.003f)));
+    p.hold(secs(2.0));
+    t.hand = p.take();
+    out.push_back(std::move(t));
+  }
+  {
+    Trajectory t;
+    t.name = "table_pressed_still";
+    t.description = "pressed 1 cm into a table at 0.2 m/s, held still for 2 s";
+    t.objects.push_back(table());
+    const Pose base = at(flat, glm::vec3(0.0f, 0.15f, 0.09f));
+    const float touch = touchOffset(hand, t.objects, base, down, 0.3f);
+    Path p(moved(base, down * (touch - 0.05f)));
+    p.moveTo(moved(base, down * (touch + 0.01f)), 0.2f);
+    p.hold(secs(2.0));
+    t.hand = p.take();
+    out.push_back(std::move(t));
+  }
+  {
+    Trajectory t;
+    t.name = "mug_pressed_still";
+    t.description = "palm pressed 1 cm into the mug's wall at 0.2 m/s, held still for 2 s";
+    t.objects.push_back(meshObject("mug", 4, makeMug(), Pose{}));
+    const glm::vec3 palm = palmEast * hand.local[size_t(Joint::palm)].position;
+    const Pose base = at(palmEast, glm::vec3(-0.25f, -palm.y, -palm.z));
+    const float touch = touchOffset(hand, t.objects, base, east, 0.3f);
+    Path p(moved(base, east * (touch - 0.05f)));
+    p.moveTo(moved(base, east * (touch + 0.01f)), 0.2f);
+    p.hold(secs(2.0));
+    t.hand = p.take();
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
+}  // namespace sdfg::outer_bench

@@ -1,0 +1,84 @@
+// autograsp-outer's scripted scenes: the objects a tracked hand meets (a table, a thin plate, the
+// mug, a thin ring) and, per trajectory, where the tracked hand is in every 90 Hz frame.
+//
+// Depths are set from the hand itself: each trajectory finds the offset along its approach at
+// which the tracked hand's joint spheres first touch the object (bisection on the exact
+// distance), then goes the stated depth past it, so "2 cm in" means the deepest joint sphere is
+// 2 cm inside, whatever the hand model's proportions.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "base/pose.h"
+#include "hand/hand_model.h"
+#include "mesh/mesh.h"
+#include "mesh/mesh_distance.h"
+#include "scene/analytic_shape.h"
+#include "scene/scene.h"
+
+namespace sdfg::outer_bench {
+
+inline constexpr double kFrameSeconds = 1.0 / 90.0;
+
+// One target of a scene: an analytic box or a mesh, with the exact distance the measurements use.
+struct SceneObject {
+  std::string name;
+  uint64_t id = 0;
+  TargetRole role = TargetRole::graspable;
+  Pose worldFromObject;
+  std::optional<AnalyticShape> shape;
+  std::shared_ptr<const TriangleMesh> mesh;
+  std::shared_ptr<const MeshDistance> distance;  // of `mesh`
+  // Signed distance of a world point, negative inside.
+  float signedDistance(const glm::vec3& world) const;
+};
+
+// A thin part the hand must not pass: in the check's frame the part is thin along Y and the hand
+// comes from +Y; a shown joint centre with y < -farSide and |x| < half.x, |z| < half.z has gone
+// through it.
+struct PassCheck {
+  Pose worldFromCheck;
+  float farSide = 0.0f;
+  glm::vec2 half{0.0f};  // x and z half extents of the footprint
+};
+
+// The tracked hand: 26 joints (hand space, the model's open pose or a squeeze) and their radii.
+struct TrackedHand {
+  HandModel model = HandModel::defaultAdult(Hand::right);
+  JointPoses local{};
+  std::array<float, kJointCount> radii{};
+  // `curl`: every finger's curl in the model's curl space (0: open, 1: a fist).
+  explicit TrackedHand(float curl = 0.0f);
+  void world(const Pose& worldFromHand, JointPoses& out) const;
+};
+
+struct Trajectory {
+  std::string name;
+  std::string description;
+  std::vector<SceneObject> objects;
+  std::vector<Pose> hand;  // worldFromHand per frame
+  std::optional<PassCheck> pass;
+};
+
+// The deepest penetration of joint spheres (world joints, radii) into any object, metres (0 when
+// clear), and the smallest clearance (negative: the depth).
+float smallestClearance(const JointPoses& joints, const std::array<float, kJointCount>& radii,
+                        const std::vector<SceneObject>& objects);
+
+// The same over the hand's bone capsules as the engine covers them (grasp/hand_clearance.h's
+// jointParts: spheres along every bone, with their radii). `cover`: with the radii grown to
+// cover the capsules between the spheres (HandPart::coverRadius), as the outer hand keeps them out.
+float smallestPartClearance(const JointPoses& joints, const std::array<float, kJointCount>& radii,
+                            const std::vector<SceneObject>& objects, bool cover = false);
+
+// Every trajectory of the benchmark, for `hand`. `scale` (0, 1] shortens holds and slides (the
+// smoke test); speeds and depths stay.
+std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale);
+
+}  // namespace sdfg::outer_bench

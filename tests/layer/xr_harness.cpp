@@ -103,7 +103,15 @@ std::string applyEnv(const XrEnv& env) {
       settings.push_back(entry.substr(0, entry.find('=')));
   }
   for (const std::string& name : settings) unsetenv(name.c_str());
-  for (const auto& [k, v] : env.extra) setenv(k.c_str(), v.c_str(), 1);
+  // And the extra variables of the previous test (a mock fault such as zero_display_time would
+  // otherwise reach every later test of a process that runs several).
+  static std::vector<std::string> previousExtra;
+  for (const std::string& name : previousExtra) unsetenv(name.c_str());
+  previousExtra.clear();
+  for (const auto& [k, v] : env.extra) {
+    setenv(k.c_str(), v.c_str(), 1);
+    previousExtra.push_back(k);
+  }
   return cv;
 }
 

@@ -588,13 +588,10 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
   }
   if (auto* setup = findInChain<XrGraspTargetsSetupInfoSDFG>(
           state->next, XR_TYPE_GRASP_TARGETS_SETUP_INFO_SDFG)) {
-    setup->readyCount = setup->pendingCount = setup->failedCount = 0;
-    for (const auto& [id, target] : s->targets) {
-      const TargetSetup st = s->grasp->targetSetup(id);
-      if (st == TargetSetup::ready) ++setup->readyCount;
-      if (st == TargetSetup::pending) ++setup->pendingCount;
-      if (st == TargetSetup::failed) ++setup->failedCount;
-    }
+    const GraspSession::SetupCounts counts = s->grasp->setupCounts();
+    setup->readyCount = uint32_t(counts.ready);
+    setup->pendingCount = uint32_t(counts.pending);
+    setup->failedCount = uint32_t(counts.failed);
   }
   writeHandOffset(*s, hand == Hand::left ? 0 : 1, state->next);
   return XR_SUCCESS;

@@ -510,15 +510,18 @@ typedef XrResult(XRAPI_PTR* PFN_xrGetGraspTargetStateSDFG)(XrGraspTargetSDFG tar
 // through a broad phase over their bounds (a tree per space), so a session may register
 // thousands.
 //
-// Which target a grab takes (the rule, deterministic):
-//   1. among the targets in the grab box that the hand may take (role GRASPABLE and, for that
-//      hand, XrGraspTargetSettingsSDFG::graspableBy) and that the hand touches, the one the most
-//      fingers touch. A finger touches the target that owns the nearest surface at its touching
-//      sphere; the palm touches a target whose surface is within 2 cm of the palm joint's sphere
-//      (a flat object under the palm, a comb on a table, is often touched by no finger: they
-//      close past it onto the table);
-//   2. between those, the one whose surface is nearest the palm joint's centre (exact distance);
-//   3. between those, the one created first.
+// Which target a grab takes (the rule, deterministic). A finger touches the target that owns the
+// nearest surface at its touching sphere; the palm touches a target whose surface is within 2 cm
+// of the palm joint's sphere (a flat object under the palm, a comb on a table, is often touched by
+// no finger: they close past it onto the table). Among the targets in the grab box that the hand
+// may take (role GRASPABLE and, for that hand, XrGraspTargetSettingsSDFG::graspableBy):
+//   1. the one the palm faces (the first surface on the ray from the palm joint along the palm's
+//      normal, within 30 cm), if a finger touches it or its surface is within 3 cm of the palm
+//      joint's sphere: fingers that wrap past it onto a neighbour (a mug beside a mug, a spoon
+//      standing in a mug) do not outvote what the palm is turned to;
+//   2. else, among those the hand touches, the one the most fingers touch;
+//   3. between those, the one whose surface is nearest the palm joint's centre (exact distance);
+//   4. between those, the one created first.
 // A target the hand does not touch is never taken (one behind another, say). While the fingers
 // touch only targets the hand may not take (a table, a wall, a target of the other hand), the hand
 // holds nothing: its fingers rest on what they touch (xrLocateHandJointsEXT shows them closed

@@ -145,21 +145,16 @@ TEST_CASE("ours meets its published quality on the Igea scan (268k)", "[quality]
 // Scenes (issue 26, eval/scene_quality.h): "ours" among other objects keeps the whole hand out of
 // every object it does not hold (p99 <= 1 mm, max <= 2 mm) and takes the graspable object its
 // palm faces. Fewer placements than the single-object gates (the first 100 of the same seeded
-// sequence) keep the label within its two minutes.
-//
-// Not met, and so not gated as passing: in "mug-beside-mug" and "spoon-in-mug" the hand takes the
-// other graspable object in some grasps (15 and 11 of 100 at the commit that added these tests):
-// target_choice.h takes the object most fingers touch, and where the palm faces the first mug
-// (or the spoon's handle) with more fingers closing onto the neighbour, the neighbour wins. Those
-// two checks run as [!mayfail] cases: their counts are printed and a failure is reported as
-// expected, so the day they pass shows too.
+// sequence) keep the label within its two minutes. (Before target_choice.h preferred the object
+// the palm faces, the hand took the other mug in 15 of 100 grasps beside a mug, and the mug in 11
+// of 100 in the spoon scene: more fingers closed on the neighbour.)
 namespace {
 
 constexpr int kScenePlacements = 100;
 constexpr double kOtherPenetrationP99Mm = 1.0;
 constexpr double kOtherPenetrationMaxMm = 2.0;
 
-// Measured once per scene: the [!mayfail] cases below read the same run as the gated ones.
+// Measured once per scene: the cases below that check the same scene read the same run.
 SceneFigures measureEmbeddedScene(const std::string& name) {
   static std::map<std::string, SceneFigures> measuredBefore;
   if (auto it = measuredBefore.find(name); it != measuredBefore.end()) return it->second;
@@ -238,13 +233,10 @@ TEST_CASE("ours keeps out of the mug the spoon stands in", "[quality][scenes]") 
   checkOutOfOthers("spoon-in-mug", measureEmbeddedScene("spoon-in-mug"));
 }
 
-// Not met yet (see above): reported, expected to fail.
-TEST_CASE("ours takes the mug its palm faces, not the one beside it",
-          "[quality][scenes][!mayfail]") {
+TEST_CASE("ours takes the mug its palm faces and not the one beside it", "[quality][scenes]") {
   checkRightObject("mug-beside-mug", measureEmbeddedScene("mug-beside-mug"));
 }
 
-TEST_CASE("ours takes the spoon its palm faces, not the mug it stands in",
-          "[quality][scenes][!mayfail]") {
+TEST_CASE("ours takes the spoon its palm faces and not the mug it stands in", "[quality][scenes]") {
   checkRightObject("spoon-in-mug", measureEmbeddedScene("spoon-in-mug"));
 }

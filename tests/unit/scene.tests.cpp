@@ -237,6 +237,8 @@ TEST_CASE("The scene's exact source answers the nearest surface and its owner", 
 
 TEST_CASE("A grasp takes the graspable target most fingers touch, then the palm's nearest",
           "[core][scene]") {
+  // The palm faces the table (not graspable) unless a section says otherwise.
+  const glm::vec3 kDown(0.0f, -1.0f, 0.0f);
   // Two blocks side by side in the hand frame, a at x = -0.03 (member 0) and b at x = +0.03
   // (member 1), and a table under both.
   const AnalyticShape block{ShapeKind::box, glm::vec3(0.02f)};
@@ -261,7 +263,7 @@ TEST_CASE("A grasp takes the graspable target most fingers touch, then the palm'
     touch(3, glm::vec3(0.03f, -0.02f - rad, 0.0f));  // under b
     touch(4, glm::vec3(0.02f, -0.02f - rad, 0.0f));
     const GraspChoice c =
-        chooseTarget(members, source, r, glm::vec3(0.0f, -0.1f, 0.0f), 0.01f, 0.01f);
+        chooseTarget(members, source, r, glm::vec3(0.0f, -0.1f, 0.0f), 0.01f, kDown, 0.01f);
     CHECK(c.member == 0);
     CHECK(c.fingersOnChoice == 3);
     CHECK(c.touched[3] == 1);
@@ -269,30 +271,48 @@ TEST_CASE("A grasp takes the graspable target most fingers touch, then the palm'
   SECTION("a tie goes to the target nearer the palm") {
     touch(1, glm::vec3(-0.03f, -0.02f - rad, 0.0f));  // a
     touch(2, glm::vec3(0.03f, -0.02f - rad, 0.0f));   // b
-    CHECK(chooseTarget(members, source, r, glm::vec3(0.02f, -0.05f, 0.0f), 0.01f, 0.01f).member ==
-          1);
-    CHECK(chooseTarget(members, source, r, glm::vec3(-0.02f, -0.05f, 0.0f), 0.01f, 0.01f).member ==
-          0);
+    CHECK(chooseTarget(members, source, r, glm::vec3(0.02f, -0.05f, 0.0f), 0.01f, kDown, 0.01f)
+              .member == 1);
+    CHECK(chooseTarget(members, source, r, glm::vec3(-0.02f, -0.05f, 0.0f), 0.01f, kDown, 0.01f)
+              .member == 0);
   }
   SECTION("a target under the palm that no finger touches is taken; one farther is not") {
     touch(1, glm::vec3(0.2f, -0.19f + rad, 0.0f));  // fingers on the table, past block a
     touch(2, glm::vec3(0.21f, -0.19f + rad, 0.0f));
     // The palm's surface (radius 1 cm) 5 mm from block a's bottom face (y = -0.02).
-    CHECK(chooseTarget(members, source, r, glm::vec3(-0.03f, -0.035f, 0.0f), 0.01f, 0.01f).member ==
-          0);
+    CHECK(chooseTarget(members, source, r, glm::vec3(-0.03f, -0.035f, 0.0f), 0.01f, kDown, 0.01f)
+              .member == 0);
     // 3 cm from it: beyond the palm's touch.
-    CHECK(chooseTarget(members, source, r, glm::vec3(-0.03f, -0.06f, 0.0f), 0.01f, 0.01f).member ==
-          -1);
+    CHECK(chooseTarget(members, source, r, glm::vec3(-0.03f, -0.06f, 0.0f), 0.01f, kDown, 0.01f)
+              .member == -1);
+  }
+  SECTION("the target the palm faces is taken when the hand touches it, whatever the count") {
+    touch(0, glm::vec3(0.03f, -0.02f - rad, 0.0f));  // three under b
+    touch(1, glm::vec3(0.02f, -0.02f - rad, 0.0f));
+    touch(2, glm::vec3(0.04f, -0.02f - rad, 0.0f));
+    touch(3, glm::vec3(-0.03f, -0.02f - rad, 0.0f));  // one under a
+    const glm::vec3 up(0.0f, 1.0f, 0.0f);
+    // The palm under a, facing up at it.
+    GraspChoice c =
+        chooseTarget(members, source, r, glm::vec3(-0.03f, -0.06f, 0.0f), 0.01f, up, 0.01f);
+    CHECK(c.faced == 0);
+    CHECK(c.member == 0);
+    CHECK(c.fingersOnChoice == 1);
+    // Facing a with no finger on it and the palm 4 cm off: not touched, so the count decides.
+    r.fingers[3].contact = false;
+    c = chooseTarget(members, source, r, glm::vec3(-0.03f, -0.07f, 0.0f), 0.01f, up, 0.01f);
+    CHECK(c.faced == 0);
+    CHECK(c.member == 1);
   }
   SECTION("fingers on the table alone hold nothing; a non-graspable target is never taken") {
     touch(1, glm::vec3(0.2f, -0.19f + rad, 0.0f));  // resting on the table's top
     const GraspChoice c =
-        chooseTarget(members, source, r, glm::vec3(0.2f, -0.1f, 0.0f), 0.01f, 0.01f);
+        chooseTarget(members, source, r, glm::vec3(0.2f, -0.1f, 0.0f), 0.01f, kDown, 0.01f);
     CHECK(c.member == -1);
     members[0].graspable = false;
     r = GraspResult{};
     touch(1, glm::vec3(-0.03f, -0.02f - rad, 0.0f));
-    CHECK(chooseTarget(members, source, r, glm::vec3(0.2f, -0.1f, 0.0f), 0.01f, 0.01f).member ==
-          -1);
+    CHECK(chooseTarget(members, source, r, glm::vec3(0.2f, -0.1f, 0.0f), 0.01f, kDown, 0.01f)
+              .member == -1);
   }
 }

@@ -85,6 +85,7 @@ Status GraspSession::addTarget(uint64_t id, TriangleMesh mesh) {
   t.vertexCount = mesh.positions.size();
   worker_->addTarget(id, std::move(mesh));
   targets_.emplace(id, std::move(t));
+  pendingSetups_.push_back(id);
   return Status::ok;
 }
 
@@ -114,8 +115,12 @@ bool GraspSession::waitWorkerIdle(std::chrono::milliseconds timeout) const {
 }
 
 void GraspSession::refreshSetups() {
-  for (auto& [id, t] : targets_) {
-    if (t.setup != TargetSetup::pending) continue;
+  // Only the targets still being set up: a room of a thousand ready targets costs nothing here.
+  size_t kept = 0;
+  for (const uint64_t id : pendingSetups_) {
+    auto it = targets_.find(id);
+    if (it == targets_.end() || it->second.setup != TargetSetup::pending) continue;
+    Target& t = it->second;
     GraspWorker::TargetInfo info = worker_->targetInfo(id);
     if (info.setup == TargetSetup::ready) {
       // Bounds set by updateTargetVertices meanwhile are newer than the set-up's.
@@ -128,9 +133,22 @@ void GraspSession::refreshSetups() {
       reindex(id, t);
     } else if (info.setup == TargetSetup::failed) {
       t.setup = TargetSetup::failed;
+      ++failedSetups_;
       setupFailures_.emplace_back(id, std::move(info.error));
+    } else {
+      pendingSetups_[kept++] = id;
     }
   }
+  pendingSetups_.resize(kept);
+}
+
+GraspSession::SetupCounts GraspSession::setupCounts() {
+  refreshSetups();
+  SetupCounts c;
+  c.pending = pendingSetups_.size();
+  c.failed = failedSetups_;
+  c.ready = targets_.size() - c.pending - c.failed;
+  return c;
 }
 
 std::optional<Pose> GraspSession::reposeCorrection(Hand side) const {
@@ -320,7 +338,11 @@ bool GraspSession::removeTarget(uint64_t id) {
   }
   worker_->removeTarget(id);
   index_.remove(id);
-  return targets_.erase(id) != 0;
+  auto it = targets_.find(id);
+  if (it == targets_.end()) return false;
+  if (it->second.setup == TargetSetup::failed) --failedSetups_;
+  targets_.erase(it);
+  return true;
 }
 
 void GraspSession::giveUp(HandState& hand, size_t slot) {

@@ -183,6 +183,11 @@ class GraspSession {
   // zero area), with the reason. The target keeps its last accepted shape; a run of refused
   // updates is reported once, at its first.
   std::vector<std::pair<uint64_t, std::string>> takeRefusedUpdates();
+  // How many targets are set up, still being set up, failed (without a loop over the targets).
+  struct SetupCounts {
+    size_t ready = 0, pending = 0, failed = 0;
+  };
+  SetupCounts setupCounts();
   // Waits until the worker has nothing queued or running, at most `timeout` (tests and tools
   // only; false on timeout).
   bool waitWorkerIdle(std::chrono::milliseconds timeout) const;
@@ -384,6 +389,8 @@ class GraspSession {
   std::map<uint64_t, Target> targets_;
   SceneIndex index_;
   std::vector<std::pair<uint64_t, MeshOrientation>> setupOrientations_;
+  std::vector<uint64_t> pendingSetups_;  // ids whose set-up may still be running (refreshSetups)
+  size_t failedSetups_ = 0;
   std::array<HandState, 2> hands_;
   std::vector<std::pair<uint64_t, std::string>> setupFailures_;
   std::unique_ptr<GraspWorker> worker_;  // last: joined before anything it could reach goes

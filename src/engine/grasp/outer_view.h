@@ -5,8 +5,9 @@
 // posts the frame's job and decides a fallback from the newest result it has (of an earlier
 // frame): the tracked hand itself when that result was clear by more than the hand moved since
 // (it is clear now too), else the hand held where that result showed it (clear, one frame
-// behind). The app draws later in its frame, usually after the worker finished the update's own
-// job: resolveOuter() then draws that result instead, on time. Reading the result takes no lock.
+// behind). An app that locates its hands after the worker finished the update's own job gets
+// that result instead (resolveOuter()), on time; most apps locate right after their sync and get
+// the fallback. Reading the result never waits for the worker's work (a pointer copy).
 #pragma once
 
 #include <array>

@@ -1,5 +1,6 @@
 #include "grasp/target_choice.h"
 
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -14,11 +15,34 @@ float distanceTo(const SceneMember& m, const glm::vec3& hand) {
   return std::abs(m.shape->closest(p, unused));
 }
 
+// The member whose surface the ray from `origin` along `direction` meets first within
+// kFacingRange (sphere tracing on the exact distances); -1 when none.
+int facedMember(size_t count, const ExactDistanceSource& scene, const glm::vec3& origin,
+                const glm::vec3& direction) {
+  constexpr float kHit = 0.001f;  // metres: the ray has met a surface
+  constexpr int kSteps = 128;
+  std::array<glm::vec3, 1> point{};
+  std::array<float, 1> bound{};
+  std::array<ExactSample, 1> found{};
+  float t = 0.0f;
+  for (int step = 0; step < kSteps && t < kFacingRange; ++step) {
+    point[0] = origin + direction * t;
+    bound[0] = kFacingRange - t;
+    found[0] = ExactSample{};
+    scene.sample(point, bound, found);
+    if (!std::isfinite(found[0].distance) || found[0].member >= count) return -1;
+    const float d = std::abs(found[0].distance);
+    if (d < kHit) return int(found[0].member);
+    t += d;
+  }
+  return -1;
+}
+
 }  // namespace
 
 GraspChoice chooseTarget(std::span<const SceneMember> members, const ExactDistanceSource& scene,
                          const GraspResult& result, const glm::vec3& palm, float palmRadius,
-                         float reach) {
+                         const glm::vec3& palmNormal, float reach) {
   GraspChoice out;
   std::array<glm::vec3, 1> point{};
   std::array<float, 1> bound{reach};
@@ -36,6 +60,16 @@ GraspChoice chooseTarget(std::span<const SceneMember> members, const ExactDistan
     ++count[found[0].member];
   }
   const glm::vec3 palmScene = result.handCorrection.transformPoint(palm);
+  out.faced = facedMember(members.size(), scene, palmScene,
+                          glm::normalize(result.handCorrection.transformVector(palmNormal)));
+  if (out.faced >= 0 && members[size_t(out.faced)].graspable) {
+    const size_t m = size_t(out.faced);
+    if (count[m] > 0 || distanceTo(members[m], palmScene) - palmRadius <= kFacedTouch) {
+      out.member = out.faced;
+      out.fingersOnChoice = count[m];
+      return out;
+    }
+  }
   float bestPalm = std::numeric_limits<float>::infinity();
   for (size_t m = 0; m < members.size(); ++m) {
     if (!members[m].graspable) continue;

@@ -4,11 +4,16 @@
 // After the fingers have closed on the whole scene, each finger in contact touches the member
 // that owns the nearest surface at its touching sphere, and the palm touches every member its
 // surface is within kPalmTouch of. The rule, deterministic:
-//   1. among the members the hand may take (SceneMember::graspable) that the hand touches (a
-//      finger, or the palm), the one the most fingers touch;
-//   2. between those, the one whose surface is nearest the palm (exact distance of the palm
+//   1. the member the palm faces (the first surface on the ray from the palm joint along the
+//      palm's normal, within kFacingRange), if the hand may take it and touches it (a finger, or
+//      the palm within kFacedTouch: the palm's turn says what the user reaches for, so it counts
+//      from a little farther than kPalmTouch): fingers that wrap past it onto a neighbour (a mug
+//      beside a mug, a spoon standing in a mug) must not outvote it;
+//   2. else among the members the hand may take (SceneMember::graspable) that the hand touches,
+//      the one the most fingers touch;
+//   3. between those, the one whose surface is nearest the palm (exact distance of the palm
 //      joint's centre);
-//   3. between those, the lowest id.
+//   4. between those, the lowest id.
 // A member the hand does not touch is never taken (one behind another, say); when it touches
 // only scene geometry, or nothing, the hand holds nothing (its fingers still rest on what they
 // touch). The palm counts because a flat object under it (a comb on a table) is often touched by
@@ -33,17 +38,23 @@ struct GraspChoice {
   // within reach of the touching sphere.
   std::array<int, kFingerCount> touched{-1, -1, -1, -1, -1};
   int fingersOnChoice = 0;
+  int faced = -1;  // the member the palm faces (-1: none within kFacingRange)
 };
 
 // The palm touches a member whose surface is within this of the palm joint's sphere.
 inline constexpr float kPalmTouch = 0.02f;  // metres
+// The palm touches the member it faces when its surface is within this of the palm's sphere.
+inline constexpr float kFacedTouch = 0.03f;  // metres
+// How far along the palm's normal the member the palm faces is looked for.
+inline constexpr float kFacingRange = 0.3f;  // metres
 
 // `scene`: the members' exact source (the one the solve used); `result`: the solve (contact
 // points in its corrected hand frame); `palm`, `palmRadius`: the palm joint's centre in the same
-// frame as the contact points, and its radius; `reach`: how far from a touching sphere's centre
-// its surface may be (the sphere's radius plus the solver's tolerance; metres).
+// frame as the contact points, and its radius; `palmNormal`: the unit normal out of the palm's
+// side, same frame; `reach`: how far from a touching sphere's centre its surface may be (the
+// sphere's radius plus the solver's tolerance; metres).
 GraspChoice chooseTarget(std::span<const SceneMember> members, const ExactDistanceSource& scene,
                          const GraspResult& result, const glm::vec3& palm, float palmRadius,
-                         float reach);
+                         const glm::vec3& palmNormal, float reach);
 
 }  // namespace sdfg

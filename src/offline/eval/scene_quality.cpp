@@ -289,8 +289,9 @@ Result<SceneFigures> measureScene(const BenchScene& scene, const SceneRun& run) 
         continue;
       }
       if (sceneAware) {
-        const GraspChoice choice = chooseTarget(members, exact, result, handFromPalm.position,
-                                                hand.jointRadius(Joint::palm), reach + kTouchReach);
+        const GraspChoice choice = chooseTarget(
+            members, exact, result, handFromPalm.position, hand.jointRadius(Joint::palm),
+            handFromPalm.orientation * glm::vec3(0.0f, -1.0f, 0.0f), reach + kTouchReach);
         g.taken = choice.member;  // members are the objects, in order
       } else if (physics) {
         g.taken = physicsTaken(objects, scene, worldFromHand, result, palm);

@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <fstream>
 
+#include "platform.h"
+
 namespace sdfg::layer {
 namespace {
 
@@ -131,11 +133,7 @@ bool applyConfigValue(Config& config, const std::string& key, const std::string&
 
 Config loadConfig() {
   Config config;
-  std::string dir;
-  if (const char* xdg = std::getenv("XDG_CONFIG_HOME"); xdg != nullptr && xdg[0] == '/')
-    dir = xdg;
-  else if (const char* home = std::getenv("HOME"); home != nullptr && home[0] != '\0')
-    dir = std::string(home) + "/.config";
+  const std::string dir = platform::userConfigDir();
   if (!dir.empty()) {
     const std::string path = dir + "/sdfg-autograsp/config";
     std::ifstream file(path);

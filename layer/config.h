@@ -1,5 +1,6 @@
 // Configuration of the layer, read once per instance: built-in defaults, then the file
-// $XDG_CONFIG_HOME/sdfg-autograsp/config (default ~/.config/sdfg-autograsp/config; lines
+// $XDG_CONFIG_HOME/sdfg-autograsp/config (default ~/.config/sdfg-autograsp/config; on Windows
+// %APPDATA%\sdfg-autograsp\config; platform.h; lines
 // "key = value", '#' comments), then environment variables SDFG_AUTOGRASP_<KEY> (key in upper
 // case), which win. Keys and meanings: docs/layer.md. Bad values are logged and ignored.
 #pragma once

@@ -1,4 +1,5 @@
 #include "log.h"
+#include "platform.h"
 
 #include <atomic>
 #include <cstdarg>
@@ -52,7 +53,9 @@ void emit(LogLevel level, const char* cmd, const char* fmt, va_list args) {
     return;
   }
   static const char* const names[] = {"", "error", "warning", "info", "debug"};
-  std::fprintf(stderr, "[sdfg_autograsp] %s: %s: %s%s\n", names[int(level)], cmd, text, suffix);
+  const std::string line =
+      std::string("[sdfg_autograsp] ") + names[int(level)] + ": " + cmd + ": " + text + suffix;
+  platform::writeLogLine(line.c_str());
 }
 
 }  // namespace

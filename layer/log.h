@@ -19,14 +19,16 @@ bool logEnabled(LogLevel level);
 void setDebugUtilsSink(XrInstance instance, PFN_xrSubmitDebugUtilsMessageEXT submit);
 void clearDebugUtilsSink(XrInstance instance);
 
+// Formats follow C99 (gnu_printf): MinGW's GCC would check plain "printf" against Microsoft's
+// older rules (no %zu), while the layer formats with the C99 vsnprintf on every system.
 // Logs "cmd: message". A site (identified by `fmt`) logs its first 10 messages, then every
 // 1000th, so a per-frame warning cannot flood the log.
 void logMessage(LogLevel level, const char* cmd, const char* fmt, ...)
-    __attribute__((format(printf, 3, 4)));
+    __attribute__((format(gnu_printf, 3, 4)));
 
 // Logs at error level and returns `result`: every error path is one return line.
 XrResult logError(XrResult result, const char* cmd, const char* fmt, ...)
-    __attribute__((format(printf, 3, 4)));
+    __attribute__((format(gnu_printf, 3, 4)));
 
 }  // namespace sdfg::layer
 

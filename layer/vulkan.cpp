@@ -3,8 +3,8 @@
 // - Vulkan entry points. Enable2 apps pass their vkGetInstanceProcAddr in
 //   xrCreateVulkanInstanceKHR / xrCreateVulkanDeviceKHR: recorded per VkInstance. Enable (v1) apps
 //   create their instance with the Vulkan loader they link; the layer takes that loader's
-//   vkGetInstanceProcAddr from the process (dlsym, or dlopen with RTLD_NOLOAD, which never loads
-//   a second copy). The layer links no Vulkan loader.
+//   vkGetInstanceProcAddr from the process (platform.h: never loads a second copy). The layer
+//   links no Vulkan loader.
 // - Queues. The binding's queue is externally synchronized and the runtime may use it only in
 //   xrBeginFrame, xrEndFrame, xrAcquireSwapchainImage and xrReleaseSwapchainImage, where the app
 //   guarantees exclusive access: the layer submits on it only inside xrBeginFrame / xrEndFrame.
@@ -12,12 +12,11 @@
 //   a spare one (xrCreateVulkanDeviceKHR); builds of CPU-array targets go there right after
 //   xrSyncActions.
 // - Failures: the backend logs one line and the session continues on the CPU.
-#include <dlfcn.h>
-
 #include <vector>
 
 #include "intercepts.h"
 #include "log.h"
+#include "platform.h"
 #include "state.h"
 
 #if SDFG_LAYER_VULKAN
@@ -40,16 +39,8 @@ PFN_vkGetInstanceProcAddr appGetInstanceProcAddr(InstanceState& inst, VkInstance
     auto it = inst.vulkanGipa.find(key(vkInstance));
     if (it != inst.vulkanGipa.end()) return it->second;
   }
-  // Enable (v1): the loader the app linked (or dlopened globally) is in the process already.
-  if (void* f = dlsym(RTLD_DEFAULT, "vkGetInstanceProcAddr"))
-    return reinterpret_cast<PFN_vkGetInstanceProcAddr>(f);
-  // Loaded with RTLD_LOCAL: find it by name without loading a new copy.
-  if (void* lib = dlopen("libvulkan.so.1", RTLD_NOW | RTLD_NOLOAD)) {
-    auto f = reinterpret_cast<PFN_vkGetInstanceProcAddr>(dlsym(lib, "vkGetInstanceProcAddr"));
-    dlclose(lib);  // drops only the reference RTLD_NOLOAD took; the app's stays
-    return f;
-  }
-  return nullptr;
+  // Enable (v1): the loader the app linked (or loaded) is in the process already.
+  return reinterpret_cast<PFN_vkGetInstanceProcAddr>(platform::loadedVulkanGetInstanceProcAddr());
 }
 
 VkGraspFault faultFromConfig(const std::string& name) {

@@ -23,6 +23,9 @@ packages=(
   libxcb-glx0-dev
   # Monado, built from ../shared/monado by `ctest -L monado` (tests/monado/build_monado.sh)
   libeigen3-dev libudev-dev
+  # Windows x64 (preset windows, docs/windows.md): MinGW-w64's cross compiler, POSIX-threads
+  # flavour (std::thread), with its binutils (dlltool, objdump); Wine 8 runs the tests
+  g++-mingw-w64-x86-64-posix wine wine64
 )
 
 missing=()

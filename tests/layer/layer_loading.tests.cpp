@@ -40,6 +40,11 @@ bool listsLayer(const char* name) {
   return false;
 }
 
+// The layer's library file (tests/windows/CMakeLists.txt names the Windows DLL).
+#ifndef SDFG_LAYER_FILE_NAME
+#define SDFG_LAYER_FILE_NAME "libXrApiLayer_sdfg_autograsp.so"
+#endif
+
 // Which shared object a function pointer lives in.
 std::string objectOf(PFN_xrVoidFunction f) {
   Dl_info info{};
@@ -131,7 +136,7 @@ TEST_CASE("The extension's functions are handed out only when the app enabled it
       CAPTURE(name);
       PFN_xrVoidFunction f = nullptr;
       CHECK(xrGetInstanceProcAddr(app.instance, name, &f) == XR_SUCCESS);
-      CHECK(objectOf(f).find("libXrApiLayer_sdfg_autograsp.so") != std::string::npos);
+      CHECK(objectOf(f).find(SDFG_LAYER_FILE_NAME) != std::string::npos);
     }
   }
   SECTION("not enabled") {
@@ -159,7 +164,7 @@ TEST_CASE("An app that never enables the extension gets the runtime's functions 
     CAPTURE(name);
     PFN_xrVoidFunction f = nullptr;
     REQUIRE(xrGetInstanceProcAddr(app.instance, name, &f) == XR_SUCCESS);
-    CHECK(objectOf(f).find("libXrApiLayer_sdfg_autograsp.so") == std::string::npos);
+    CHECK(objectOf(f).find(SDFG_LAYER_FILE_NAME) == std::string::npos);
   }
   CHECK(validationLog().empty());
 }

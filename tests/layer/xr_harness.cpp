@@ -69,6 +69,8 @@ std::string applyEnv(const XrEnv& env) {
   // The layer under test is implicit, found under $XDG_DATA_HOME; nothing else implicit is.
   const fs::path implicit = fs::path(dir) / "data/openxr/1/api_layers/implicit.d";
   fs::create_directories(implicit);
+  // Removed first: MinGW's libstdc++ 12 refuses to overwrite, whatever the options say.
+  fs::remove(implicit / "XrApiLayer_sdfg_autograsp.json");
   fs::copy_file(SDFG_LAYER_JSON, implicit / "XrApiLayer_sdfg_autograsp.json",
                 fs::copy_options::overwrite_existing);
   setenv("XDG_DATA_HOME", (fs::path(dir) / "data").c_str(), 1);
@@ -76,7 +78,9 @@ std::string applyEnv(const XrEnv& env) {
   setenv("XDG_CONFIG_DIRS", (fs::path(dir) / "no-config").c_str(), 1);
   setenv("XDG_CONFIG_HOME", (fs::path(dir) / "config").c_str(), 1);
   setenv("XR_RUNTIME_JSON", SDFG_MOCK_RUNTIME_JSON, 1);
+#ifndef _WIN32  // the SDK the Windows loader is built from has no core validation layer
   setenv("XR_ENABLE_API_LAYERS", "XR_APILAYER_LUNARG_core_validation", 1);
+#endif
   const std::string cv = dir + "/core-validation.txt";
   setenv("XR_CORE_VALIDATION_FILE_NAME", cv.c_str(), 1);
   if (env.layer)
@@ -99,7 +103,15 @@ std::string applyEnv(const XrEnv& env) {
       settings.push_back(entry.substr(0, entry.find('=')));
   }
   for (const std::string& name : settings) unsetenv(name.c_str());
-  for (const auto& [k, v] : env.extra) setenv(k.c_str(), v.c_str(), 1);
+  // And the extra variables of the previous test (a mock fault such as zero_display_time would
+  // otherwise reach every later test of a process that runs several).
+  static std::vector<std::string> previousExtra;
+  for (const std::string& name : previousExtra) unsetenv(name.c_str());
+  previousExtra.clear();
+  for (const auto& [k, v] : env.extra) {
+    setenv(k.c_str(), v.c_str(), 1);
+    previousExtra.push_back(k);
+  }
   return cv;
 }
 
@@ -319,6 +331,8 @@ App::App(const AppOptions& options) {
     binding.queueFamilyIndex = vk.family;
     binding.queueIndex = 0;
     sci.next = &binding;
+  } else {
+    sci.next = options.sessionNext;
   }
   if (xrCreateSession(instance, &sci, &session) != XR_SUCCESS) return;
   XrReferenceSpaceCreateInfo rs{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};

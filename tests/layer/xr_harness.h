@@ -44,6 +44,9 @@ struct AppOptions {
   std::vector<std::string> extensions;  // besides the graphics extension, always enabled
   bool appActions = true;               // suggest, attach and sync an app action set
   Graphics graphics = Graphics::headless;
+  // Graphics::headless: chained into xrCreateSession as it is (a binding the mock runtime
+  // ignores, such as D3D11's with no device: tests/windows/layer_d3d.tests.cpp).
+  const void* sessionNext = nullptr;
 };
 
 // The app's Vulkan side (Graphics::vulkan*) on lavapipe, with the Khronos validation layer and a

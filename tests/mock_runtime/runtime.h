@@ -38,7 +38,7 @@ namespace sdfg::mock {
 // Logs "cmd: message" on stderr when SDFG_MOCK_LOG=1 and returns `result`, so every error path
 // is one return line that also says why.
 XrResult fail(const char* cmd, XrResult result, const char* fmt, ...)
-    __attribute__((format(printf, 3, 4)));
+    __attribute__((format(gnu_printf, 3, 4)));  // C99 on MinGW too
 
 // Single statements (do/while), so they are safe under an unbraced `if`.
 #define MOCK_VERIFY_NOT_NULL(cmd, arg)                                                         \

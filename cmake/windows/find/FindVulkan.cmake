@@ -1,0 +1,30 @@
+# Vulkan for the Windows cross build. Vulkan::Headers: the host's headers, copied.
+# Vulkan::Vulkan: an import library for vulkan-1.dll (the Vulkan loader every Windows system with
+# a Vulkan driver has; Wine's forwards to the host's), made with dlltool from the functions the
+# headers declare. Only tests and the mock runtime link it; the layer never does.
+if(NOT TARGET Vulkan::Headers AND EXISTS ${SDFG_HOST_INCLUDE}/vulkan/vulkan_core.h)
+  add_library(Vulkan::Headers INTERFACE IMPORTED GLOBAL)
+  set_target_properties(Vulkan::Headers PROPERTIES INTERFACE_INCLUDE_DIRECTORIES ${SDFG_HOST_INCLUDE})
+  set(_def ${CMAKE_BINARY_DIR}/vulkan-1.def)
+  set(_lib ${CMAKE_BINARY_DIR}/libvulkan-1.dll.a)
+  if(NOT EXISTS ${_lib})
+    file(STRINGS ${SDFG_HOST_INCLUDE}/vulkan/vulkan_core.h _protos REGEX "^VKAPI_ATTR .* VKAPI_CALL vk[A-Za-z0-9]+\\(")
+    set(_text "LIBRARY vulkan-1.dll\nEXPORTS\n")
+    foreach(p IN LISTS _protos)
+      string(REGEX MATCH "vk[A-Za-z0-9]+\\(" name "${p}")
+      string(REPLACE "(" "" name "${name}")
+      string(APPEND _text "  ${name}\n")
+    endforeach()
+    file(WRITE ${_def} "${_text}")
+    find_program(SDFG_DLLTOOL NAMES x86_64-w64-mingw32-dlltool REQUIRED)
+    execute_process(COMMAND ${SDFG_DLLTOOL} -d ${_def} -l ${_lib} RESULT_VARIABLE _rc)
+    if(NOT _rc EQUAL 0)
+      message(FATAL_ERROR "dlltool could not make ${_lib}")
+    endif()
+  endif()
+  add_library(Vulkan::Vulkan UNKNOWN IMPORTED GLOBAL)
+  set_target_properties(Vulkan::Vulkan PROPERTIES IMPORTED_LOCATION ${_lib}
+    INTERFACE_LINK_LIBRARIES Vulkan::Headers)
+endif()
+include(FindPackageHandleStandardArgs)
+find_package_handle_standard_args(Vulkan REQUIRED_VARS SDFG_HOST_INCLUDE)

@@ -324,9 +324,12 @@ bool Renderer::render(const DrawList& list, const glm::mat4& viewProjection, con
     if (!ensureBuffer(vertices_, VkDeviceSize(count * sizeof(Vertex)),
                       VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, error))
       return false;
-    std::memcpy(vertices_.mapped, list.lit.data(), list.lit.size() * sizeof(Vertex));
-    std::memcpy(static_cast<Vertex*>(vertices_.mapped) + list.lit.size(), list.overlay.data(),
-                list.overlay.size() * sizeof(Vertex));
+    // An empty list's data() may be null, which memcpy may not be given even for no bytes.
+    if (!list.lit.empty())
+      std::memcpy(vertices_.mapped, list.lit.data(), list.lit.size() * sizeof(Vertex));
+    if (!list.overlay.empty())
+      std::memcpy(static_cast<Vertex*>(vertices_.mapped) + list.lit.size(), list.overlay.data(),
+                  list.overlay.size() * sizeof(Vertex));
   }
   DEMO_VK(vkResetCommandBuffer(commands_, 0));
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};

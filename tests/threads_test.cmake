@@ -14,7 +14,7 @@ if(NOT out MATCHES "locate p99, slow sync / normal sync")
   message(FATAL_ERROR "no ratio line in the output:\n${out}")
 endif()
 file(READ ${WORK}/threads.json json)
-foreach(key frames delay_us hardware_threads locate_normal locate_slow_sync locate_p99_ratio
+foreach(key provenance frames delay_us hardware_threads locate_normal locate_slow_sync locate_p99_ratio
             destroys)
   string(JSON v ERROR_VARIABLE e GET "${json}" ${key})
   if(e)

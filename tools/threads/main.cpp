@@ -35,16 +35,18 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "build_info.h"
+#include "cli_options.h"
 #include "hand/hand_model.h"
 #include "hand/hand_synthesis.h"
 #include "io/shapes.h"
+#include "json_file.h"
 #include "mock_runtime_test.h"
 #include "sdf/sdf_grid.h"
 #include "threads_config.h"
@@ -470,26 +472,30 @@ Destroys destroyDuringBuild(int trials, int resolution) {
 int main(int argc, char** argv) {
   int frames = 600, trials = 10;
   uint32_t delayUs = 4000;
-  bool quick = false;
+  bool quick = false, help = false;
   std::string json;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--frames" && i + 1 < argc) {
-      frames = std::max(10, std::atoi(argv[++i]));
-    } else if (a == "--delay-us" && i + 1 < argc) {
-      delayUs = uint32_t(std::max(1, std::atoi(argv[++i])));
-    } else if (a == "--trials" && i + 1 < argc) {
-      trials = std::max(1, std::atoi(argv[++i]));
-    } else if (a == "--json" && i + 1 < argc) {
-      json = argv[++i];
-    } else if (a == "--quick") {
-      quick = true;
-    } else {
-      std::fprintf(stderr,
-                   "usage: autograsp-threads [--frames N] [--delay-us D] [--trials N] [--quick] "
-                   "[--json FILE]\n");
-      return 2;
-    }
+  const char* const usage =
+      "usage: autograsp-threads [--frames N] [--delay-us D] [--trials N] [--quick] "
+      "[--json FILE]\n"
+      "  --frames N     frames per run, 10..100000 (default 600)\n"
+      "  --delay-us D   how long the gated runtime call takes, 1..1000000 us (default 4000)\n"
+      "  --trials N     destroys per kind, 1..1000 (default 10)\n"
+      "  --quick        a short run (the smoke test)\n"
+      "  --json FILE    write the figures as JSON\n";
+  CLI::App cli{"", "autograsp-threads"};
+  sdfg::tools::cli::addHelpFlag(cli, help);
+  sdfg::tools::cli::addInteger(cli, "--frames", frames, 10, 100000);
+  sdfg::tools::cli::addInteger(cli, "--delay-us", delayUs, 1, 1000000);
+  sdfg::tools::cli::addInteger(cli, "--trials", trials, 1, 1000);
+  cli.add_flag("--quick", quick);
+  sdfg::tools::cli::addName(cli, "--json", json, "file name");
+  if (auto error = sdfg::tools::cli::parse(cli, argc, argv)) {
+    std::fprintf(stderr, "autograsp-threads: %s\n%s", error->c_str(), usage);
+    return 2;
+  }
+  if (help) {
+    std::fputs(usage, stdout);
+    return 0;
   }
   if (std::getenv("XR_RUNTIME_JSON") == nullptr)
     setenv("XR_RUNTIME_JSON", SDFG_THREADS_MOCK_RUNTIME_JSON, 1);
@@ -541,26 +547,37 @@ int main(int argc, char** argv) {
   row("xrDestroyInstance", ("set-up of " + setupName).c_str(), instanceSetup);
   row("xrDestroySession", buildName.c_str(), sessionBuild);
   if (!json.empty()) {
-    std::ofstream f(json);
-    const auto d = [&](const char* name, const Destroys& x, bool last) {
-      f << "    \"" << name << "\": {\"trials\": " << x.trials << ", \"p50_ms\": " << x.callMs.p50
-        << ", \"max_ms\": " << x.callMs.max << ", \"whole_ms\": " << x.wholeMs << "}"
-        << (last ? "\n" : ",\n");
+    using sdfg::tools::Json;
+    using sdfg::tools::jsonNumber;
+    const auto locate = [](const TwoThreads& o) {
+      return Json{{"p50_ms", jsonNumber(o.locate.p50)},
+                  {"p99_ms", jsonNumber(o.locate.p99)},
+                  {"max_ms", jsonNumber(o.locate.max)},
+                  {"during_sync", o.overlapped},
+                  {"sync_p50_ms", jsonNumber(o.syncMs)}};
     };
-    f << "{\n  \"tool\": \"autograsp-threads\",\n  \"frames\": " << frames
-      << ",\n  \"delay_us\": " << delayUs
-      << ",\n  \"hardware_threads\": " << std::thread::hardware_concurrency()
-      << ",\n  \"locate_normal\": {\"p50_ms\": " << normal.locate.p50
-      << ", \"p99_ms\": " << normal.locate.p99 << ", \"max_ms\": " << normal.locate.max
-      << ", \"during_sync\": " << normal.overlapped << ", \"sync_p50_ms\": " << normal.syncMs
-      << "},\n  \"locate_slow_sync\": {\"p50_ms\": " << slow.locate.p50
-      << ", \"p99_ms\": " << slow.locate.p99 << ", \"max_ms\": " << slow.locate.max
-      << ", \"during_sync\": " << slow.overlapped << ", \"sync_p50_ms\": " << slow.syncMs
-      << "},\n  \"locate_p99_ratio\": " << ratio << ",\n  \"destroys\": {\n";
-    d("session_during_setup", sessionSetup, false);
-    d("instance_during_setup", instanceSetup, false);
-    d("session_during_build", sessionBuild, true);
-    f << "  }\n}\n";
+    const auto destroys = [](const Destroys& x) {
+      return Json{{"trials", x.trials},
+                  {"p50_ms", jsonNumber(x.callMs.p50)},
+                  {"max_ms", jsonNumber(x.callMs.max)},
+                  {"whole_ms", jsonNumber(x.wholeMs)}};
+    };
+    const Json out{{"tool", "autograsp-threads"},
+                   {"provenance", sdfg::tools::provenanceJson()},
+                   {"frames", frames},
+                   {"delay_us", delayUs},
+                   {"hardware_threads", std::thread::hardware_concurrency()},
+                   {"locate_normal", locate(normal)},
+                   {"locate_slow_sync", locate(slow)},
+                   {"locate_p99_ratio", jsonNumber(ratio)},
+                   {"destroys",
+                    {{"session_during_setup", destroys(sessionSetup)},
+                     {"instance_during_setup", destroys(instanceSetup)},
+                     {"session_during_build", destroys(sessionBuild)}}}};
+    if (auto error = sdfg::tools::writeJsonFile(json, out)) {
+      std::fprintf(stderr, "autograsp-threads: %s\n", error->message.c_str());
+      return 1;
+    }
     std::printf("\nwrote %s\n", json.c_str());
   }
   return 0;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "eval/evaluator.h"
+#include "eval/percentile.h"
 #include "eval/placements.h"
 #include "mesh/mesh_distance.h"
 #include "sdf/sdf_cpu.h"
@@ -16,16 +17,6 @@
 namespace sdfg {
 
 namespace {
-
-// Linear interpolation between order statistics, as the benchmark's tables.
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const double pos = q * double(v.size() - 1);
-  const size_t lo = size_t(std::floor(pos));
-  const size_t hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (v[hi] - v[lo]) * (pos - double(lo));
-}
 
 struct Graded {
   GraspMetrics metrics;

@@ -14,6 +14,7 @@
 
 #include "eval/approaching.h"
 #include "eval/evaluator.h"
+#include "eval/percentile.h"
 #include "eval/placements.h"
 #include "eval/solver_physics.h"
 #include "eval/strategies.h"
@@ -30,18 +31,8 @@ namespace {
 // How far past a touching sphere's radius its surface may be for target_choice.h: the worker's
 // reach (grasp_worker.cpp, kTouchReach), restated because the engine keeps it private.
 constexpr float kTouchReach = 0.002f;  // metres
-constexpr float kFacingRange = 0.3f;   // metres: the palm ray's length
 constexpr float kFacingHit = 0.001f;   // metres: the ray has met a surface
 constexpr int kFacingSteps = 200;
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const double pos = q * double(v.size() - 1);
-  const size_t lo = size_t(std::floor(pos));
-  const size_t hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (v[hi] - v[lo]) * (pos - double(lo));
-}
 
 // An object as the graders and the solvers see it.
 struct Prepared {
@@ -66,7 +57,8 @@ std::pair<int, double> nearestObject(const std::vector<Prepared>& objects, const
 }
 
 // The object the palm faces: sphere tracing from the palm joint along the palm's normal (the
-// hand's -Y, the palm side), on the exact distances. -1: nothing within kFacingRange.
+// hand's -Y, the palm side), on the grader's exact distances, as far as the engine's rule looks
+// (target_choice.h, kFacingRange). -1: nothing within it.
 int facedObject(const std::vector<Prepared>& objects, const Pose& worldFromPalm) {
   const glm::vec3 direction = worldFromPalm.orientation * glm::vec3(0.0f, -1.0f, 0.0f);
   float t = 0.0f;

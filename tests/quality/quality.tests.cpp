@@ -181,8 +181,9 @@ SceneFigures measureEmbeddedScene(const std::string& name) {
       name.c_str(), q.grasps, q.otherPenetrationP99Mm, q.otherPenetrationMaxMm, q.deepestPlacement,
       q.deepestObject.c_str(), q.otherPenetrating, q.wrongObject, q.facingGraspable,
       q.firstWrongPlacement, q.heldNothing, q.wrongFingersOnTaken, q.wrongFingersOnFaced,
-      q.wrongWithFingerOnFaced, q.contactsPerGrasp, q.penetrationMaxMm, q.contactResidualMedianMm,
-      q.contactResidualP95Mm, q.earlyStops, q.passThroughs);
+      q.wrongWithFingerOnFaced, q.held.contactsPerGrasp, q.held.penetrationMaxMm,
+      q.held.contactResidualMedianMm, q.held.contactResidualP95Mm, q.held.earlyStops,
+      q.held.passThroughs);
   CHECK(q.grasps == kScenePlacements);
   measuredBefore[name] = q;
   return q;

@@ -128,10 +128,10 @@ TEST_CASE("A scene's figures are a function of the seed", "[core][scenes]") {
     REQUIRE(b.ok());
     CHECK(a->grasps == 4);
     CHECK(a->otherPenetrationMaxMm == b->otherPenetrationMaxMm);
-    CHECK(a->contactsPerGrasp == b->contactsPerGrasp);
+    CHECK(a->held.contactsPerGrasp == b->held.contactsPerGrasp);
     CHECK(a->wrongObject == b->wrongObject);
     CHECK(a->facingGraspable == b->facingGraspable);
-    CHECK(a->contactResidualP95Mm == b->contactResidualP95Mm);
+    CHECK(a->held.contactResidualP95Mm == b->held.contactResidualP95Mm);
   }
   run.method = "no-such-method";
   CHECK_FALSE(measureScene(scene, run).ok());

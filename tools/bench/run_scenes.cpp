@@ -60,8 +60,9 @@ void printSceneTable(const std::vector<SceneRow>& rows) {
         std::to_string(f.wrongObject) + "/" + std::to_string(f.facingGraspable);
     std::printf("%-*s %-15s %7d %9.3f %9.3f %11s %8d %9.3f %9.4f %9.3f %6d %5d\n", width,
                 r.scene.c_str(), r.method.c_str(), f.grasps, f.otherPenetrationP99Mm,
-                f.otherPenetrationMaxMm, wrong.c_str(), f.heldNothing, f.contactsPerGrasp,
-                f.contactResidualP95Mm, f.penetrationMaxMm, f.earlyStops, f.passThroughs);
+                f.otherPenetrationMaxMm, wrong.c_str(), f.heldNothing, f.held.contactsPerGrasp,
+                f.held.contactResidualP95Mm, f.held.penetrationMaxMm, f.held.earlyStops,
+                f.held.passThroughs);
   }
 }
 
@@ -88,16 +89,17 @@ tools::Json scenesJson(const std::vector<SceneRow>& rows) {
     row["wrong_fingers_on_taken"] = f.wrongFingersOnTaken;
     row["wrong_fingers_on_faced"] = f.wrongFingersOnFaced;
     row["wrong_with_finger_on_faced"] = f.wrongWithFingerOnFaced;
-    row["contacts_mean"] = jsonNumber(f.contactsPerGrasp);
-    row["fingers_in_contact"] = f.fingersInContact;
+    row["contacts_mean"] = jsonNumber(f.held.contactsPerGrasp);
+    row["fingers_in_contact"] = f.held.fingersInContact;
     // NaN-free: no finger in contact reads as null.
-    const bool any = f.fingersInContact > 0;
-    row["contact_residual_mm"] = {{"median", any ? jsonNumber(f.contactResidualMedianMm) : Json()},
-                                  {"p95", any ? jsonNumber(f.contactResidualP95Mm) : Json()}};
-    row["penetration_mm"] = {{"p99", jsonNumber(f.penetrationP99Mm)},
-                             {"max", jsonNumber(f.penetrationMaxMm)}};
-    row["early_stops"] = f.earlyStops;
-    row["pass_through"] = f.passThroughs;
+    const bool any = f.held.fingersInContact > 0;
+    row["contact_residual_mm"] = {
+        {"median", any ? jsonNumber(f.held.contactResidualMedianMm) : Json()},
+        {"p95", any ? jsonNumber(f.held.contactResidualP95Mm) : Json()}};
+    row["penetration_mm"] = {{"p99", jsonNumber(f.held.penetrationP99Mm)},
+                             {"max", jsonNumber(f.held.penetrationMaxMm)}};
+    row["early_stops"] = f.held.earlyStops;
+    row["pass_through"] = f.held.passThroughs;
     out.push_back(std::move(row));
   }
   return out;

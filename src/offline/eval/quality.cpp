@@ -93,32 +93,37 @@ Result<QualityFigures> measureQuality(const TriangleMesh& original, const Qualit
   work(0);
   for (std::thread& th : pool) th.join();
 
-  QualityFigures out;
-  std::vector<double> residuals, penetrations;
-  int touching = 0;
+  QualityTally tally;
   for (size_t p = 0; p < graded.size(); ++p) {
     if (graded[p].error) return *graded[p].error;
-    const GraspMetrics& m = graded[p].metrics;
-    ++out.grasps;
-    penetrations.push_back(m.penetrationMm);
-    if (m.penetrationMm > out.penetrationMaxMm || out.deepestPlacement < 0) {
-      out.penetrationMaxMm = m.penetrationMm;
-      out.deepestPlacement = int(p);
-    }
-    out.earlyStops += m.earlyStops;
-    if (m.earlyStops > 0 && out.earlyStopPlacement < 0) out.earlyStopPlacement = int(p);
-    out.passThroughs += m.passThroughs;
-    touching += m.contacts;
-    for (const FingerMetrics& f : m.fingers) {
-      if (!f.contact) continue;
-      residuals.push_back(f.contactResidualMm);
-    }
+    tally.add(int(p), graded[p].metrics);
   }
-  out.fingersInContact = int(residuals.size());
-  out.contactResidualMedianMm = percentile(residuals, 0.5);
-  out.contactResidualP95Mm = percentile(residuals, 0.95);
-  out.penetrationP99Mm = percentile(penetrations, 0.99);
-  out.contactsPerGrasp = out.grasps > 0 ? double(touching) / out.grasps : 0.0;
+  return tally.figures();
+}
+
+void QualityTally::add(int placement, const GraspMetrics& m) {
+  ++sums_.grasps;
+  penetrations_.push_back(m.penetrationMm);
+  if (m.penetrationMm > sums_.penetrationMaxMm || sums_.deepestPlacement < 0) {
+    sums_.penetrationMaxMm = m.penetrationMm;
+    sums_.deepestPlacement = placement;
+  }
+  sums_.earlyStops += m.earlyStops;
+  if (m.earlyStops > 0 && sums_.earlyStopPlacement < 0) sums_.earlyStopPlacement = placement;
+  sums_.passThroughs += m.passThroughs;
+  touching_ += m.contacts;
+  for (const FingerMetrics& f : m.fingers) {
+    if (f.contact) residuals_.push_back(f.contactResidualMm);
+  }
+}
+
+QualityFigures QualityTally::figures() const {
+  QualityFigures out = sums_;
+  out.fingersInContact = int(residuals_.size());
+  out.contactResidualMedianMm = percentile(residuals_, 0.5);
+  out.contactResidualP95Mm = percentile(residuals_, 0.95);
+  out.penetrationP99Mm = percentile(penetrations_, 0.99);
+  out.contactsPerGrasp = out.grasps > 0 ? double(touching_) / out.grasps : 0.0;
   return out;
 }
 

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "base/status.h"
 #include "grasp/solver.h"
@@ -49,6 +50,22 @@ struct QualityFigures {
   int earlyStopPlacement = -1;
 
   double earlyStopsPer1000() const { return grasps > 0 ? 1000.0 * earlyStops / grasps : 0.0; }
+};
+
+struct GraspMetrics;  // eval/evaluator.h
+
+// Sums grasps into QualityFigures, in placement order: the one sum behind measureQuality() and a
+// scene's figures on the object held (eval/scene_quality.h).
+class QualityTally {
+ public:
+  void add(int placement, const GraspMetrics& grasp);
+  QualityFigures figures() const;  // the percentiles over what was added
+
+ private:
+  QualityFigures sums_;
+  std::vector<double> residuals_;     // per finger in contact
+  std::vector<double> penetrations_;  // per grasp
+  int touching_ = 0;
 };
 
 // Runs `run` on `mesh` (any size and place: it is scaled to kBenchObjectDiagonal). Errors: an

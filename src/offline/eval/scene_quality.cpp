@@ -323,8 +323,8 @@ Result<SceneFigures> measureScene(const BenchScene& scene, const SceneRun& run) 
   for (std::thread& th : pool) th.join();
 
   SceneFigures out;
-  std::vector<double> other, residuals, penetrations;
-  int touching = 0;
+  std::vector<double> other;
+  QualityTally held;
   for (size_t p = 0; p < graded.size(); ++p) {
     const Graded& g = graded[p];
     if (g.error) return *g.error;
@@ -354,22 +354,10 @@ Result<SceneFigures> measureScene(const BenchScene& scene, const SceneRun& run) 
         out.wrongWithFingerOnFaced += onFaced ? 1 : 0;
       }
     }
-    const GraspMetrics& m = g.metrics;
-    penetrations.push_back(m.penetrationMm);
-    out.penetrationMaxMm = std::max(out.penetrationMaxMm, double(m.penetrationMm));
-    out.earlyStops += m.earlyStops;
-    out.passThroughs += m.passThroughs;
-    touching += m.contacts;
-    for (const FingerMetrics& f : m.fingers) {
-      if (f.contact) residuals.push_back(f.contactResidualMm);
-    }
+    held.add(int(p), g.metrics);
   }
   out.otherPenetrationP99Mm = percentile(other, 0.99);
-  out.fingersInContact = int(residuals.size());
-  out.contactResidualMedianMm = percentile(residuals, 0.5);
-  out.contactResidualP95Mm = percentile(residuals, 0.95);
-  out.penetrationP99Mm = percentile(penetrations, 0.99);
-  out.contactsPerGrasp = out.grasps > 0 ? double(touching) / out.grasps : 0.0;
+  out.held = held.figures();
   return out;
 }
 

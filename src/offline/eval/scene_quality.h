@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "base/status.h"
+#include "eval/quality.h"
 #include "eval/scenes.h"
 #include "grasp/solver.h"
 #include "sdf/sdf_grid.h"
@@ -68,15 +69,9 @@ struct SceneFigures {
   // The wrong grasps where some finger in contact was on the object faced: a rule that took the
   // faced object whenever a finger touches it would have taken it there.
   int wrongWithFingerOnFaced = 0;
-  // Single-object figures on the object held (else the one reached for).
-  double contactsPerGrasp = 0.0;  // fingers touching it (within kTouchingMm), mean
-  int fingersInContact = 0;
-  double contactResidualMedianMm = 0.0;
-  double contactResidualP95Mm = 0.0;
-  double penetrationP99Mm = 0.0;  // fingers into it, per grasp's deepest
-  double penetrationMaxMm = 0.0;
-  int earlyStops = 0;
-  int passThroughs = 0;
+  // Single-object figures on the object held (else the one reached for): fingers touching it,
+  // contact residuals, fingers into it (per grasp's deepest), early stops, pass-throughs.
+  QualityFigures held;
 };
 
 // Errors: an unknown strategy, invalid options, fewer placements found than asked, or a failed

@@ -218,33 +218,13 @@ class App {
 
   // Creates the target (timed). False on refusal.
   bool createTarget(const Object& o, const XrPosef& pose, double& callMs) {
-    XrGraspTargetVerticesSDFG v{XR_TYPE_GRASP_TARGET_VERTICES_SDFG};
-    v.vertexCount = uint32_t(o.vertices.size());
-    v.vertices = o.vertices.data();
-    v.indexCount = uint32_t(o.indices.size());
-    v.indices = o.indices.data();
-    XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &v};
-    ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, local_, pose};
-    const auto t0 = Clock::now();
-    const XrResult r = createTarget_(session_, &ci, &target_);
-    callMs = ms(Clock::now() - t0);
-    return r == XR_SUCCESS;
+    return create(o, pose, target_, callMs);
   }
 
   // Creates one more target (timed), kept until the session ends. False on refusal.
   bool addTarget(const Object& o, const XrPosef& pose, double& callMs) {
-    XrGraspTargetVerticesSDFG v{XR_TYPE_GRASP_TARGET_VERTICES_SDFG};
-    v.vertexCount = uint32_t(o.vertices.size());
-    v.vertices = o.vertices.data();
-    v.indexCount = uint32_t(o.indices.size());
-    v.indices = o.indices.data();
-    XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &v};
-    ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, local_, pose};
     XrGraspTargetSDFG handle = XR_NULL_HANDLE;
-    const auto t0 = Clock::now();
-    const XrResult r = createTarget_(session_, &ci, &handle);
-    callMs = ms(Clock::now() - t0);
-    if (r != XR_SUCCESS) return false;
+    if (!create(o, pose, handle, callMs)) return false;
     others_.push_back(handle);
     return true;
   }
@@ -335,6 +315,21 @@ class App {
   bool layer() const { return layer_; }
 
  private:
+  // xrCreateGraspTargetSDFG on `o` at `pose`, the call timed.
+  bool create(const Object& o, const XrPosef& pose, XrGraspTargetSDFG& handle, double& callMs) {
+    XrGraspTargetVerticesSDFG v{XR_TYPE_GRASP_TARGET_VERTICES_SDFG};
+    v.vertexCount = uint32_t(o.vertices.size());
+    v.vertices = o.vertices.data();
+    v.indexCount = uint32_t(o.indices.size());
+    v.indices = o.indices.data();
+    XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &v};
+    ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, local_, pose};
+    const auto t0 = Clock::now();
+    const XrResult r = createTarget_(session_, &ci, &handle);
+    callMs = ms(Clock::now() - t0);
+    return r == XR_SUCCESS;
+  }
+
   template <class F>
   F fn(const char* name) const {
     PFN_xrVoidFunction f = nullptr;

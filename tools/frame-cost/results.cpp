@@ -21,6 +21,35 @@ Percentiles percentiles(std::vector<double> v) {
   return p;
 }
 
+namespace {
+
+// A phase's time added by the layer, beside the layer-off run's own frame totals.
+tools::Json phaseJson(const Percentiles& added, double offMedian, const Percentiles& off) {
+  using tools::jsonNumber;
+  return {{"frames", added.count},
+          {"added_p50_ms", jsonNumber(added.p50)},
+          {"added_p99_ms", jsonNumber(added.p99)},
+          {"added_max_ms", jsonNumber(added.max)},
+          {"off_median_ms", jsonNumber(offMedian)},
+          {"off_p99_ms", jsonNumber(off.p99)},
+          {"off_max_ms", jsonNumber(off.max)}};
+}
+
+// Each OpenXR call's own time with the layer on.
+tools::Json callsJson(const std::map<std::string, std::vector<double>>& callMs) {
+  using tools::jsonNumber;
+  tools::Json calls = tools::Json::object();
+  for (const auto& [name, v] : callMs) {
+    const Percentiles c = percentiles(v);
+    calls[name] = {{"p50_ms", jsonNumber(c.p50)},
+                   {"p99_ms", jsonNumber(c.p99)},
+                   {"max_ms", jsonNumber(c.max)}};
+  }
+  return calls;
+}
+
+}  // namespace
+
 tools::Json resultsJson(const std::vector<MeshResult>& results, int phaseFrames,
                         double framePeriodMs, const std::vector<std::string>& skipped,
                         const OuterResult* outer) {
@@ -46,23 +75,10 @@ tools::Json resultsJson(const std::vector<MeshResult>& results, int phaseFrames,
     m["grab_latency_frames"] = r.on.grabLatencyFrames;
     Json& phases = m["phases"] = Json::object();
     for (int p = 0; p < kPhaseCount; ++p) {
-      const Percentiles& a = r.added[p];
-      phases[kPhases[p]] = {{"frames", a.count},
-                            {"added_p50_ms", jsonNumber(a.p50)},
-                            {"added_p99_ms", jsonNumber(a.p99)},
-                            {"added_max_ms", jsonNumber(a.max)},
-                            {"off_median_ms", jsonNumber(r.offMedian[p])},
-                            {"off_p99_ms", jsonNumber(r.offStats[p].p99)},
-                            {"off_max_ms", jsonNumber(r.offStats[p].max)},
-                            {"cpu_builds", r.on.builds[p]}};
+      Json& phase = phases[kPhases[p]] = phaseJson(r.added[p], r.offMedian[p], r.offStats[p]);
+      phase["cpu_builds"] = r.on.builds[p];
     }
-    Json& calls = m["calls_on"] = Json::object();
-    for (const auto& [name, v] : r.on.callMs) {
-      const Percentiles c = percentiles(v);
-      calls[name] = {{"p50_ms", jsonNumber(c.p50)},
-                     {"p99_ms", jsonNumber(c.p99)},
-                     {"max_ms", jsonNumber(c.max)}};
-    }
+    m["calls_on"] = callsJson(r.on.callMs);
     meshes.push_back(std::move(m));
   }
   if (outer != nullptr) {
@@ -77,28 +93,14 @@ tools::Json resultsJson(const std::vector<MeshResult>& results, int phaseFrames,
     o["setup_ms"] = jsonNumber(r.on.setupMs);
     Json& phases = o["phases"] = Json::object();
     for (int p = 0; p < kOuterPhaseCount; ++p) {
-      const Percentiles& a = r.added[p];
-      phases[kOuterPhases[p]] = {
-          {"frames", a.count},
-          {"added_p50_ms", jsonNumber(a.p50)},
-          {"added_p99_ms", jsonNumber(a.p99)},
-          {"added_max_ms", jsonNumber(a.max)},
-          {"off_median_ms", jsonNumber(r.offMedian[p])},
-          {"off_p99_ms", jsonNumber(r.offStats[p].p99)},
-          {"off_max_ms", jsonNumber(r.offStats[p].max)},
-          {"hand_moved_frames", r.on.movedFrames[p]},
-          {"outer_hand_off_added_p50_ms", jsonNumber(r.addedWithoutOuter[p].p50)},
-          {"outer_hand_off_added_p99_ms", jsonNumber(r.addedWithoutOuter[p].p99)},
-          {"outer_hand_off_added_max_ms", jsonNumber(r.addedWithoutOuter[p].max)},
-          {"outer_hand_off_hand_moved_frames", r.onWithoutOuter.movedFrames[p]}};
+      Json& phase = phases[kOuterPhases[p]] = phaseJson(r.added[p], r.offMedian[p], r.offStats[p]);
+      phase["hand_moved_frames"] = r.on.movedFrames[p];
+      phase["outer_hand_off_added_p50_ms"] = jsonNumber(r.addedWithoutOuter[p].p50);
+      phase["outer_hand_off_added_p99_ms"] = jsonNumber(r.addedWithoutOuter[p].p99);
+      phase["outer_hand_off_added_max_ms"] = jsonNumber(r.addedWithoutOuter[p].max);
+      phase["outer_hand_off_hand_moved_frames"] = r.onWithoutOuter.movedFrames[p];
     }
-    Json& calls = o["calls_on"] = Json::object();
-    for (const auto& [name, v] : r.on.callMs) {
-      const Percentiles c = percentiles(v);
-      calls[name] = {{"p50_ms", jsonNumber(c.p50)},
-                     {"p99_ms", jsonNumber(c.p99)},
-                     {"max_ms", jsonNumber(c.max)}};
-    }
+    o["calls_on"] = callsJson(r.on.callMs);
     out["outer"] = std::move(o);
   }
   return out;

@@ -104,6 +104,30 @@ Pose at(const glm::quat& q, const glm::vec3& p) {
   return Pose{q, p};
 }
 
+// Along `dir` from `base`, where the hand first touches at `touch`: from 10 cm before the touch
+// in to `depth` past it at `speed`, `stay` seconds there and back out at `speed`, with pauses
+// before and after (holds shortened by `scale`).
+std::vector<Pose> pushAndBack(const Pose& base, const glm::vec3& dir, float touch, float depth,
+                              float speed, double stay, float scale) {
+  const Pose start = moved(base, dir * (touch - 0.10f));
+  Path p(start);
+  p.hold(0.2 * double(scale));
+  p.moveTo(moved(base, dir * (touch + depth)), speed);
+  p.hold(stay * double(scale));
+  p.moveTo(start, speed);
+  p.hold(0.3 * double(scale));
+  return p.take();
+}
+
+// Along `dir` from `base`, where the hand first touches at `touch`: from 5 cm before the touch
+// pressed 1 cm past it at 0.2 m/s, then held still for 2 s (shortened by `scale`).
+std::vector<Pose> pressAndHold(const Pose& base, const glm::vec3& dir, float touch, float scale) {
+  Path p(moved(base, dir * (touch - 0.05f)));
+  p.moveTo(moved(base, dir * (touch + 0.01f)), 0.2f);
+  p.hold(2.0 * double(scale));
+  return p.take();
+}
+
 }  // namespace
 
 float SceneObject::signedDistance(const glm::vec3& world) const {
@@ -148,6 +172,10 @@ std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale) {
   const glm::quat flat(1, 0, 0, 0);  // palm down, fingers toward -Z
   const glm::quat palmEast = glm::angleAxis(0.5f * kPi, glm::vec3(0, 0, 1));  // palm toward +X
   auto secs = [&](double s) { return s * double(scale); };
+  // Palm down 15 cm over the table; palm toward the mug's axis from -X, at the palm's height.
+  const Pose overTable = at(flat, glm::vec3(0.0f, 0.15f, 0.09f));
+  const glm::vec3 palmBesideMug = palmEast * hand.local[size_t(Joint::palm)].position;
+  const Pose besideMug = at(palmEast, glm::vec3(-0.25f, -palmBesideMug.y, -palmBesideMug.z));
   std::vector<Trajectory> out;
 
   // 1. Into the table 2 cm past its surface, then along it.
@@ -156,11 +184,10 @@ std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale) {
     t.name = "table_slide";
     t.description = "reach 2 cm into a table (box, scene role) at 0.5 m/s, slide 20 cm + 10 cm";
     t.objects.push_back(table());
-    const Pose base = at(flat, glm::vec3(0.0f, 0.15f, 0.09f));
-    const float touch = touchOffset(hand, t.objects, base, down, 0.3f);
-    Path p(moved(base, down * (touch - 0.10f)));
+    const float touch = touchOffset(hand, t.objects, overTable, down, 0.3f);
+    Path p(moved(overTable, down * (touch - 0.10f)));
     p.hold(secs(0.2));
-    p.moveTo(moved(base, down * (touch + 0.02f)), 0.5f);
+    p.moveTo(moved(overTable, down * (touch + 0.02f)), 0.5f);
     p.hold(secs(0.2));
     p.moveTo(moved(p.last(), east * 0.2f * scale), 0.3f);
     p.moveTo(moved(p.last(), glm::vec3(0, 0, -0.1f * scale)), 0.3f);
@@ -178,16 +205,8 @@ std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale) {
     t.description = "palm first through a 3 mm plate (30 x 30 cm mesh) to 6 cm past its touch";
     t.objects.push_back(meshObject("plate", 2, makeThinPlate(0.30f, 0.30f, 0.003f), Pose{}));
     t.pass = PassCheck{Pose{}, 0.0015f, glm::vec2(0.15f, 0.15f)};
-    const Pose base = at(flat, glm::vec3(0.0f, 0.15f, 0.09f));
-    const float touch = touchOffset(hand, t.objects, base, down, 0.3f);
-    const Pose start = moved(base, down * (touch - 0.10f));
-    Path p(start);
-    p.hold(secs(0.2));
-    p.moveTo(moved(base, down * (touch + 0.06f)), speed);
-    p.hold(secs(0.2));
-    p.moveTo(start, speed);
-    p.hold(secs(0.3));
-    t.hand = p.take();
+    const float touch = touchOffset(hand, t.objects, overTable, down, 0.3f);
+    t.hand = pushAndBack(overTable, down, touch, 0.06f, speed, 0.2, scale);
     out.push_back(std::move(t));
   }
 
@@ -197,13 +216,11 @@ std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale) {
     t.name = "mug_slide";
     t.description = "palm 2 cm inside the mug's wall, circling it +-60 degrees at 1.5 rad/s";
     t.objects.push_back(meshObject("mug", 4, makeMug(), Pose{}));
-    const glm::vec3 palm = palmEast * hand.local[size_t(Joint::palm)].position;
-    const Pose base = at(palmEast, glm::vec3(-0.25f, -palm.y, -palm.z));
-    const float touch = touchOffset(hand, t.objects, base, east, 0.3f);
-    const Pose start = moved(base, east * (touch - 0.10f));
+    const float touch = touchOffset(hand, t.objects, besideMug, east, 0.3f);
+    const Pose start = moved(besideMug, east * (touch - 0.10f));
     Path p(start);
     p.hold(secs(0.2));
-    p.moveTo(moved(base, east * (touch + 0.02f)), 0.5f);
+    p.moveTo(moved(besideMug, east * (touch + 0.02f)), 0.5f);
     p.hold(secs(0.2));
     const float turn = glm::radians(60.0f) * scale;
     p.orbit(glm::vec3(0.0f), -turn, 1.5f);
@@ -230,14 +247,7 @@ std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale) {
     t.pass =
         PassCheck{at(palmEast, glm::vec3(-0.06f, 0.0f, 0.0f)), 0.005f, glm::vec2(0.005f, 0.01f)};
     const float touch = touchOffset(hand, t.objects, base, east, 0.3f);
-    const Pose start = moved(base, east * (touch - 0.10f));
-    Path p(start);
-    p.hold(secs(0.2));
-    p.moveTo(moved(base, east * (touch + 0.06f)), speed);
-    p.hold(secs(0.1));
-    p.moveTo(start, speed);
-    p.hold(secs(0.3));
-    t.hand = p.take();
+    t.hand = pushAndBack(base, east, touch, 0.06f, speed, 0.1, scale);
     out.push_back(std::move(t));
   }
   for (float speed : {2.0f, 3.0f, 5.0f}) {
@@ -252,14 +262,7 @@ std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale) {
     const glm::vec3 palm = hand.local[size_t(Joint::palm)].position;
     const Pose base = at(flat, glm::vec3(-0.30f, -0.01f - palm.y, 0.09f));
     const float touch = touchOffset(hand, t.objects, base, east, 0.4f);
-    const Pose start = moved(base, east * (touch - 0.10f));
-    Path p(start);
-    p.hold(secs(0.2));
-    p.moveTo(moved(base, east * (touch + 0.06f)), speed);
-    p.hold(secs(0.1));
-    p.moveTo(start, speed);
-    p.hold(secs(0.3));
-    t.hand = p.take();
+    t.hand = pushAndBack(base, east, touch, 0.06f, speed, 0.1, scale);
     out.push_back(std::move(t));
   }
 
@@ -270,9 +273,8 @@ std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale) {
     t.name = "table_near_still";
     t.description = "held still 3 mm above a table for 2 s";
     t.objects.push_back(table());
-    const Pose base = at(flat, glm::vec3(0.0f, 0.15f, 0.09f));
-    const float touch = touchOffset(hand, t.objects, base, down, 0.3f);
-    Path p(moved(base, down * (touch - 0.003f)));
+    const float touch = touchOffset(hand, t.objects, overTable, down, 0.3f);
+    Path p(moved(overTable, down * (touch - 0.003f)));
     p.hold(secs(2.0));
     t.hand = p.take();
     out.push_back(std::move(t));
@@ -282,12 +284,8 @@ std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale) {
     t.name = "table_pressed_still";
     t.description = "pressed 1 cm into a table at 0.2 m/s, held still for 2 s";
     t.objects.push_back(table());
-    const Pose base = at(flat, glm::vec3(0.0f, 0.15f, 0.09f));
-    const float touch = touchOffset(hand, t.objects, base, down, 0.3f);
-    Path p(moved(base, down * (touch - 0.05f)));
-    p.moveTo(moved(base, down * (touch + 0.01f)), 0.2f);
-    p.hold(secs(2.0));
-    t.hand = p.take();
+    const float touch = touchOffset(hand, t.objects, overTable, down, 0.3f);
+    t.hand = pressAndHold(overTable, down, touch, scale);
     out.push_back(std::move(t));
   }
   {
@@ -295,13 +293,8 @@ std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale) {
     t.name = "mug_pressed_still";
     t.description = "palm pressed 1 cm into the mug's wall at 0.2 m/s, held still for 2 s";
     t.objects.push_back(meshObject("mug", 4, makeMug(), Pose{}));
-    const glm::vec3 palm = palmEast * hand.local[size_t(Joint::palm)].position;
-    const Pose base = at(palmEast, glm::vec3(-0.25f, -palm.y, -palm.z));
-    const float touch = touchOffset(hand, t.objects, base, east, 0.3f);
-    Path p(moved(base, east * (touch - 0.05f)));
-    p.moveTo(moved(base, east * (touch + 0.01f)), 0.2f);
-    p.hold(secs(2.0));
-    t.hand = p.take();
+    const float touch = touchOffset(hand, t.objects, besideMug, east, 0.3f);
+    t.hand = pressAndHold(besideMug, east, touch, scale);
     out.push_back(std::move(t));
   }
   return out;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 namespace sdfg::tools::cli {
@@ -125,6 +126,21 @@ std::optional<std::string> parse(CLI::App& app, int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return std::string(e.what());
+  }
+  return std::nullopt;
+}
+
+std::optional<int> parseOrUsage(CLI::App& app, int argc, char** argv, const char* tool,
+                                const char* usage) {
+  bool help = false;
+  addHelpFlag(app, help);
+  if (auto error = parse(app, argc, argv)) {
+    std::fprintf(stderr, "%s: %s\n%s", tool, error->c_str(), usage);
+    return 2;
+  }
+  if (help) {
+    std::fputs(usage, stdout);
+    return 0;
   }
   return std::nullopt;
 }

@@ -61,6 +61,12 @@ CLI::Option* addList(CLI::App& app, const std::string& name, std::vector<std::st
 // Parses the arguments. Returns the first error's message (CLI11's or one of the rules above).
 std::optional<std::string> parse(CLI::App& app, int argc, char** argv);
 
+// Parses a tool's arguments, with -h / --help printing the tool's own `usage`. Returns the exit
+// code when the tool is done: 2 after "<tool>: <error>" and the usage on stderr, 0 after the
+// usage on stdout for --help; nothing when it goes on.
+std::optional<int> parseOrUsage(CLI::App& app, int argc, char** argv, const char* tool,
+                                const char* usage);
+
 // Splits a comma-separated list, dropping empty items ("16,,32," gives 16 and 32).
 std::vector<std::string> splitList(const std::string& text);
 

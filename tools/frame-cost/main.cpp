@@ -561,11 +561,10 @@ OuterRun runOuter(const OuterScene& scene, bool layer, bool outerHand, int phase
 int main(int argc, char** argv) {
   int phaseFrames = 60;
   int room = 5;
-  bool embeddedOnly = false, help = false;
+  bool embeddedOnly = false;
   std::string json;
   std::vector<std::string> onlyNames;
   CLI::App cli{"", "autograsp-frame-cost"};
-  sdfg::tools::cli::addHelpFlag(cli, help);
   // Fewer than 2 frames per phase leave nothing to take percentiles of: raised to 2, as always.
   sdfg::tools::cli::addInteger(
       cli, "--frames", std::numeric_limits<int>::min(), std::numeric_limits<int>::max(),
@@ -574,14 +573,8 @@ int main(int argc, char** argv) {
   sdfg::tools::cli::addInteger(cli, "--room", room, 5, 100000);
   sdfg::tools::cli::addName(cli, "--json", json, "file name");
   sdfg::tools::cli::addRepeatable(cli, "--only", onlyNames);
-  if (auto error = sdfg::tools::cli::parse(cli, argc, argv)) {
-    std::fprintf(stderr, "autograsp-frame-cost: %s\n%s", error->c_str(), kUsage);
-    return 2;
-  }
-  if (help) {
-    std::fputs(kUsage, stdout);
-    return 0;
-  }
+  if (auto exit = sdfg::tools::cli::parseOrUsage(cli, argc, argv, "autograsp-frame-cost", kUsage))
+    return *exit;
   const std::set<std::string> only(onlyNames.begin(), onlyNames.end());
   if (std::getenv("XR_RUNTIME_JSON") == nullptr)
     setenv("XR_RUNTIME_JSON", SDFG_FC_MOCK_RUNTIME_JSON, 1);

@@ -238,13 +238,12 @@ Json summaryJson(const Summary& s, bool perFrame) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool quick = false, waitWorker = false, check = false, perFrame = false, help = false;
+  bool quick = false, waitWorker = false, check = false, perFrame = false;
   float drawAt = 8.0f;
   float squeeze = 0.0f;
   std::string json;
   std::vector<std::string> only;
   CLI::App cli{"", "autograsp-outer"};
-  sdfg::tools::cli::addHelpFlag(cli, help);
   cli.add_flag("--quick", quick);
   cli.add_flag("--wait-worker", waitWorker);
   cli.add_flag("--check", check);
@@ -257,14 +256,8 @@ int main(int argc, char** argv) {
       "a number from 0 to 1");
   sdfg::tools::cli::addRepeatable(cli, "--only", only);
   sdfg::tools::cli::addName(cli, "--json", json, "file name");
-  if (auto error = sdfg::tools::cli::parse(cli, argc, argv)) {
-    std::fprintf(stderr, "autograsp-outer: %s\n%s", error->c_str(), kUsage);
-    return 2;
-  }
-  if (help) {
-    std::fputs(kUsage, stdout);
-    return 0;
-  }
+  if (auto exit = sdfg::tools::cli::parseOrUsage(cli, argc, argv, "autograsp-outer", kUsage))
+    return *exit;
 
   const TrackedHand hand(squeeze);
   std::vector<Trajectory> trajectories = makeTrajectories(hand, quick ? 0.25f : 1.0f);

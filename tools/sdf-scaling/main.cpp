@@ -57,11 +57,10 @@ int main(int argc, char** argv) {
   namespace cli = tools::cli;
   std::filesystem::path meshDir = "../shared/meshes";
   int runs = 5;
-  bool quick = false, torusRows = true, meshRows = true, help = false;
+  bool quick = false, torusRows = true, meshRows = true;
   tools::TimedBuilderOptions builderOptions;
   std::vector<uint32_t> resolutions = {16, 32, 64};
   CLI::App app{"", "autograsp-sdf-scaling"};
-  cli::addHelpFlag(app, help);
   std::string meshes;
   cli::addName(app, "--meshes", meshes, "folder name");
   // --runs and --wg below 1 are raised to 1, as they always were.
@@ -83,14 +82,7 @@ int main(int argc, char** argv) {
   app.add_flag("--quick", quick);
   std::vector<long long> res;
   cli::addIntegerList(app, "--res", kMinGridResolution, kMaxGridResolution, "resolution", res);
-  if (auto error = cli::parse(app, argc, argv)) {
-    std::fprintf(stderr, "autograsp-sdf-scaling: %s\n%s", error->c_str(), kUsage);
-    return 2;
-  }
-  if (help) {
-    std::fputs(kUsage, stdout);
-    return 0;
-  }
+  if (auto exit = cli::parseOrUsage(app, argc, argv, "autograsp-sdf-scaling", kUsage)) return *exit;
   if (!meshes.empty()) meshDir = meshes;
   if (!res.empty()) resolutions.assign(res.begin(), res.end());
   if (!only.empty()) {

@@ -472,7 +472,7 @@ Destroys destroyDuringBuild(int trials, int resolution) {
 int main(int argc, char** argv) {
   int frames = 600, trials = 10;
   uint32_t delayUs = 4000;
-  bool quick = false, help = false;
+  bool quick = false;
   std::string json;
   const char* const usage =
       "usage: autograsp-threads [--frames N] [--delay-us D] [--trials N] [--quick] "
@@ -483,20 +483,13 @@ int main(int argc, char** argv) {
       "  --quick        a short run (the smoke test)\n"
       "  --json FILE    write the figures as JSON\n";
   CLI::App cli{"", "autograsp-threads"};
-  sdfg::tools::cli::addHelpFlag(cli, help);
   sdfg::tools::cli::addInteger(cli, "--frames", frames, 10, 100000);
   sdfg::tools::cli::addInteger(cli, "--delay-us", delayUs, 1, 1000000);
   sdfg::tools::cli::addInteger(cli, "--trials", trials, 1, 1000);
   cli.add_flag("--quick", quick);
   sdfg::tools::cli::addName(cli, "--json", json, "file name");
-  if (auto error = sdfg::tools::cli::parse(cli, argc, argv)) {
-    std::fprintf(stderr, "autograsp-threads: %s\n%s", error->c_str(), usage);
-    return 2;
-  }
-  if (help) {
-    std::fputs(usage, stdout);
-    return 0;
-  }
+  if (auto exit = sdfg::tools::cli::parseOrUsage(cli, argc, argv, "autograsp-threads", usage))
+    return *exit;
   if (std::getenv("XR_RUNTIME_JSON") == nullptr)
     setenv("XR_RUNTIME_JSON", SDFG_THREADS_MOCK_RUNTIME_JSON, 1);
   setenv("SDFG_MOCK_HAND_TRACKING", "absent", 1);

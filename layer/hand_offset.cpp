@@ -8,6 +8,20 @@
 #include "state.h"
 
 namespace sdfg::layer {
+namespace {
+
+// Enums compared as integers: an app may pass any value.
+bool isSwitch(XrGraspSwitchSDFG v) {
+  const int i = int(v);
+  return i >= int(XR_GRASP_SWITCH_DEFAULT_SDFG) && i <= int(XR_GRASP_SWITCH_ON_SDFG);
+}
+
+// 0 (the default) or a value in (0, hi].
+bool zeroOrUpTo(float v, float hi) {
+  return v == 0.0f || (v > 0.0f && v <= hi);
+}
+
+}  // namespace
 
 void ClearanceRequest::apply(GraspSettings& settings, float& blendTime) const {
   if (!present) return;
@@ -43,28 +57,22 @@ XrResult readClearanceOptions(const char* cmd, const void* next, ClearanceReques
       findInChain<const XrGraspClearanceOptionsSDFG>(next, XR_TYPE_GRASP_CLEARANCE_OPTIONS_SDFG);
   out = ClearanceRequest{};
   if (c == nullptr) return XR_SUCCESS;
-  // Enums compared as integers: an app may pass any value.
-  auto isSwitch = [](XrGraspSwitchSDFG v) {
-    const int i = int(v);
-    return i >= int(XR_GRASP_SWITCH_DEFAULT_SDFG) && i <= int(XR_GRASP_SWITCH_ON_SDFG);
-  };
-  auto inRange = [](float v, float hi) { return v == 0.0f || (v > 0.0f && v <= hi); };
   if (!isSwitch(c->clearance))
     return logError(XR_ERROR_VALIDATION_FAILURE, cmd, "(clearanceOptions->clearance) is %d",
                     int(c->clearance));
   if (!isSwitch(c->approach))
     return logError(XR_ERROR_VALIDATION_FAILURE, cmd, "(clearanceOptions->approach) is %d",
                     int(c->approach));
-  if (!inRange(c->maxCorrection, 0.2f))
+  if (!zeroOrUpTo(c->maxCorrection, 0.2f))
     return logError(XR_ERROR_VALIDATION_FAILURE, cmd,
                     "(clearanceOptions->maxCorrection) must be 0 or in (0, 0.2]");
-  if (!inRange(c->approachRange, 0.2f))
+  if (!zeroOrUpTo(c->approachRange, 0.2f))
     return logError(XR_ERROR_VALIDATION_FAILURE, cmd,
                     "(clearanceOptions->approachRange) must be 0 or in (0, 0.2]");
-  if (!inRange(c->approachMaxAngle, 3.1416f))
+  if (!zeroOrUpTo(c->approachMaxAngle, 3.1416f))
     return logError(XR_ERROR_VALIDATION_FAILURE, cmd,
                     "(clearanceOptions->approachMaxAngle) must be 0 or in (0, pi]");
-  if (!inRange(c->blendTime, 2.0f))
+  if (!zeroOrUpTo(c->blendTime, 2.0f))
     return logError(XR_ERROR_VALIDATION_FAILURE, cmd,
                     "(clearanceOptions->blendTime) must be 0 or in (0, 2]");
   out.present = true;
@@ -86,14 +94,13 @@ XrResult readOuterHandOptions(const char* cmd, const void* next, OuterHandReques
       findInChain<const XrGraspOuterHandOptionsSDFG>(next, XR_TYPE_GRASP_OUTER_HAND_OPTIONS_SDFG);
   out = OuterHandRequest{};
   if (o == nullptr) return XR_SUCCESS;
-  const int sw = int(o->outerHand);
-  if (sw < int(XR_GRASP_SWITCH_DEFAULT_SDFG) || sw > int(XR_GRASP_SWITCH_ON_SDFG))
-    return logError(XR_ERROR_VALIDATION_FAILURE, cmd, "(outerHandOptions->outerHand) is %d", sw);
-  auto inRange = [](float v, float hi) { return v == 0.0f || (v > 0.0f && v <= hi); };
-  if (!inRange(o->releaseDistance, 1.0f))
+  if (!isSwitch(o->outerHand))
+    return logError(XR_ERROR_VALIDATION_FAILURE, cmd, "(outerHandOptions->outerHand) is %d",
+                    int(o->outerHand));
+  if (!zeroOrUpTo(o->releaseDistance, 1.0f))
     return logError(XR_ERROR_VALIDATION_FAILURE, cmd,
                     "(outerHandOptions->releaseDistance) must be 0 or in (0, 1]");
-  if (!inRange(o->blendTime, 2.0f))
+  if (!zeroOrUpTo(o->blendTime, 2.0f))
     return logError(XR_ERROR_VALIDATION_FAILURE, cmd,
                     "(outerHandOptions->blendTime) must be 0 or in (0, 2]");
   out.present = true;

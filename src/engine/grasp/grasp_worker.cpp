@@ -268,6 +268,16 @@ void GraspWorker::run() {
   idle_.notify_all();
 }
 
+SceneMember GraspWorker::sceneMember(const JobMember& m, const Target& t) {
+  SceneMember out;
+  out.id = m.target;
+  out.mesh = t.distance.get();
+  out.shape = t.shape ? &*t.shape : nullptr;
+  out.objectFromHand = m.objectFromHand;
+  out.graspable = m.graspable;
+  return out;
+}
+
 bool GraspWorker::anyQueued() const {
   return !setups_.empty() || slots_[0].queued || slots_[1].queued || outer_[0].queued ||
          outer_[1].queued;
@@ -303,12 +313,7 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
     const Target& t = *it->second;
     if (t.distance == nullptr && !t.shape) continue;
     keep.push_back(it->second);
-    SceneMember sm;
-    sm.id = m.target;
-    sm.mesh = t.distance.get();
-    sm.shape = t.shape ? &*t.shape : nullptr;
-    sm.objectFromHand = m.objectFromHand;
-    scene.push_back(sm);
+    scene.push_back(sceneMember(m, t));
     if (scene.size() == kMaxSceneMembers) break;
   }
   std::shared_ptr<Target> attached;
@@ -534,13 +539,7 @@ void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job jo
     for (size_t i = 0; i < resolved.size(); ++i) {
       const Resolved& r = resolved[i];
       if (r.target == nullptr || (r.target->distance == nullptr && !r.target->shape)) continue;
-      SceneMember m;
-      m.id = job.members[i].target;
-      m.mesh = r.target->distance.get();
-      m.shape = r.target->shape ? &*r.target->shape : nullptr;
-      m.objectFromHand = job.members[i].objectFromHand;
-      m.graspable = job.members[i].graspable;
-      scene.push_back(m);
+      scene.push_back(sceneMember(job.members[i], *r.target));
       sceneIndex.push_back(i);
       if (scene.size() == kMaxSceneMembers) break;
     }

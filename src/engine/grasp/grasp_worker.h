@@ -293,6 +293,9 @@ class GraspWorker {
   void runOuter(std::unique_lock<std::mutex>& lock, size_t slot, OuterJob job);
   // Anything queued (the caller holds the mutex).
   bool anyQueued() const;
+  // A job member as the exact source and the field read it: the target's mesh or shape (the
+  // caller keeps the target alive while the member is used).
+  static SceneMember sceneMember(const JobMember& m, const Target& t);
   // After the solve: which target the hand takes, what each finger touches, and the contacts on
   // the target taken (Done::chosen, touched, contacts, objectFromHand, version).
   static void chooseAndContact(const Job& job, std::span<const SceneMember> scene,

@@ -20,8 +20,7 @@ Result<ApproachResult> approachPose(const SdfGrid& field, const HandModel& hand,
   hand.pose(FingerCurls{0.0f, 0.0f, 0.0f, 0.0f, 0.0f}, joints);
   const Pose& palm = joints[size_t(Joint::palm)];
   const glm::vec3 palmPoint = palm.position;
-  // The palm side of the hand is -Y of the palm joint.
-  const glm::vec3 palmNormal = palm.transformVector(glm::vec3(0.0f, -1.0f, 0.0f));
+  const glm::vec3 palmNormal = palmFacing(palm);
   const float target = options.targetDistance >= 0.0f ? options.targetDistance
                                                       : hand.jointRadius(Joint::palm) + 0.005f;
 

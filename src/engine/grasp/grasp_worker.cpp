@@ -657,8 +657,7 @@ void GraspWorker::chooseAndContact(const Job& job, std::span<const SceneMember> 
       scene.empty() ? GraspChoice{}
                     : chooseTarget(scene, exact, done.result, open[size_t(Joint::palm)].position,
                                    model.jointRadius(Joint::palm),
-                                   open[size_t(Joint::palm)].orientation * glm::vec3(0, -1, 0),
-                                   reach + kTouchReach);
+                                   palmFacing(open[size_t(Joint::palm)]), reach + kTouchReach);
   for (int f = 0; f < kFingerCount; ++f) {
     const int m = choice.touched[size_t(f)];
     done.touched[size_t(f)] = m >= 0 ? scene[size_t(m)].id : 0;

@@ -225,8 +225,7 @@ Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {
     const glm::vec3 g = field.gradient(palm_);
     JointPoses open{};
     hand_.pose(FingerCurls{}, open);
-    const glm::vec3 palmNormal =
-        open[size_t(Joint::palm)].transformVector(glm::vec3(0.0f, -1.0f, 0.0f));
+    const glm::vec3 palmNormal = palmFacing(open[size_t(Joint::palm)]);
     const float gl = glm::length(g);
     const float facing =
         gl > 1e-3f ? std::acos(std::clamp(glm::dot(palmNormal, -g / gl), -1.0f, 1.0f)) : 0.0f;

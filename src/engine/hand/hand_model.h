@@ -67,6 +67,12 @@ using JointCurls = std::array<float, 4>;
 const char* jointName(Joint joint);
 const char* fingerName(Finger finger);
 
+// The unit direction the palm side of the hand faces, from the palm joint's pose: its -Y (the
+// OpenXR hand joints' convention).
+inline glm::vec3 palmFacing(const Pose& palm) {
+  return palm.transformVector(glm::vec3(0.0f, -1.0f, 0.0f));
+}
+
 // Joints of a finger from its metacarpal to its tip: 4 for the thumb (it has no intermediate
 // phalanx), 5 for the others.
 std::span<const Joint> fingerJoints(Finger finger);

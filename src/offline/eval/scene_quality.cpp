@@ -60,7 +60,7 @@ std::pair<int, double> nearestObject(const std::vector<Prepared>& objects, const
 // hand's -Y, the palm side), on the grader's exact distances, as far as the engine's rule looks
 // (target_choice.h, kFacingRange). -1: nothing within it.
 int facedObject(const std::vector<Prepared>& objects, const Pose& worldFromPalm) {
-  const glm::vec3 direction = worldFromPalm.orientation * glm::vec3(0.0f, -1.0f, 0.0f);
+  const glm::vec3 direction = palmFacing(worldFromPalm);
   float t = 0.0f;
   for (int step = 0; step < kFacingSteps && t < kFacingRange; ++step) {
     const auto [object, distance] = nearestObject(objects, worldFromPalm.position + direction * t);
@@ -281,9 +281,9 @@ Result<SceneFigures> measureScene(const BenchScene& scene, const SceneRun& run) 
         continue;
       }
       if (sceneAware) {
-        const GraspChoice choice = chooseTarget(
-            members, exact, result, handFromPalm.position, hand.jointRadius(Joint::palm),
-            handFromPalm.orientation * glm::vec3(0.0f, -1.0f, 0.0f), reach + kTouchReach);
+        const GraspChoice choice = chooseTarget(members, exact, result, handFromPalm.position,
+                                                hand.jointRadius(Joint::palm),
+                                                palmFacing(handFromPalm), reach + kTouchReach);
         g.taken = choice.member;  // members are the objects, in order
       } else if (physics) {
         g.taken = physicsTaken(objects, scene, worldFromHand, result, palm);

@@ -6,21 +6,6 @@
 
 namespace sdfg::frame_cost {
 
-Percentiles percentiles(std::vector<double> v) {
-  Percentiles p;
-  p.count = v.size();
-  if (v.empty()) return p;
-  std::sort(v.begin(), v.end());
-  auto at = [&](double q) {
-    const size_t i = size_t(std::ceil(q * double(v.size()))) - 1;
-    return v[std::min(i, v.size() - 1)];
-  };
-  p.p50 = at(0.5);
-  p.p99 = at(0.99);
-  p.max = v.back();
-  return p;
-}
-
 namespace {
 
 // A phase's time added by the layer, beside the layer-off run's own frame totals.

@@ -13,6 +13,7 @@
 
 #include "base/status.h"
 #include "json_file.h"
+#include "percentiles.h"
 
 namespace sdfg::frame_cost {
 
@@ -20,12 +21,8 @@ inline constexpr int kPhaseCount = 5;
 inline constexpr const char* kPhases[kPhaseCount] = {"open", "grab", "held", "held_moving",
                                                      "held_deforming"};
 
-struct Percentiles {
-  double p50 = 0, p99 = 0, max = 0;
-  size_t count = 0;
-};
-// Nearest-rank percentiles of `v` (all zero for an empty one).
-Percentiles percentiles(std::vector<double> v);
+using tools::Percentiles;
+using tools::percentiles;
 
 // What one run (layer on or off) measured.
 struct RunResult {

@@ -35,6 +35,7 @@
 #include "cli_options.h"
 #include "grasp/outer_hand.h"
 #include "json_file.h"
+#include "percentiles.h"
 #include "run.h"
 #include "trajectories.h"
 
@@ -71,29 +72,15 @@ constexpr int kSettleFrames = 9;
 // OuterHandOptions::margin's default: the clearance the shown hand keeps.
 const float kClearMargin = sdfg::OuterHandOptions{}.margin;
 
-struct Stats {
-  double p50 = 0, p99 = 0, max = 0;
-};
-Stats stats(std::vector<double> v) {
-  Stats s;
-  if (v.empty()) return s;
-  std::sort(v.begin(), v.end());
-  auto rank = [&](double q) {
-    size_t i = size_t(std::ceil(q * double(v.size())));
-    return v[std::min(v.size() - 1, i == 0 ? 0 : i - 1)];
-  };
-  s.p50 = rank(0.5);
-  s.p99 = rank(0.99);
-  s.max = v.back();
-  return s;
-}
+using sdfg::tools::Percentiles;
+using sdfg::tools::percentiles;
 
 struct Summary {
   std::string name, description;
   size_t frames = 0;
   bool ok = false;
   std::string error;
-  Stats penetrationMm;              // shown hand, outer on
+  Percentiles penetrationMm;        // shown hand, outer on
   double capsulePenetrationMm = 0;  // the same over the bone capsules, max
   double trackedDepthMm = 0;        // deepest the tracked hand went
   size_t clearFrames = 0;           // tracked clear and not past a thin part
@@ -108,7 +95,7 @@ struct Summary {
   bool passThrough = false;
   bool trackedPast = false;
   size_t activeFrames = 0, onTimeFrames = 0;
-  Stats costOn, costOff;              // update + draw, ms
+  Percentiles costOn, costOff;        // update + draw, ms
   std::vector<FrameRecord> perFrame;  // the outer-on run's, for --per-frame
   // The targets as stated.
   bool meets() const { return meetsByDesign() && offWhileClearMm == 0.0; }
@@ -160,14 +147,14 @@ Summary summarize(const Trajectory& t, const RunRecord& on, const RunRecord& off
     costOn.push_back(r.updateMs + r.drawMs);
   }
   for (const FrameRecord& r : off.frames) costOff.push_back(r.updateMs + r.drawMs);
-  s.penetrationMm = stats(pen);
-  s.costOn = stats(costOn);
-  s.costOff = stats(costOff);
+  s.penetrationMm = percentiles(pen);
+  s.costOn = percentiles(costOn);
+  s.costOff = percentiles(costOff);
   s.perFrame = on.frames;
   return s;
 }
 
-Json statsJson(const Stats& s) {
+Json percentilesJson(const Percentiles& s) {
   return Json{{"p50", jsonNumber(s.p50)}, {"p99", jsonNumber(s.p99)}, {"max", jsonNumber(s.max)}};
 }
 
@@ -212,7 +199,7 @@ Json summaryJson(const Summary& s, bool perFrame) {
     j["error"] = s.error;
     return j;
   }
-  j["penetration_mm"] = statsJson(s.penetrationMm);
+  j["penetration_mm"] = percentilesJson(s.penetrationMm);
   j["capsule_penetration_max_mm"] = jsonNumber(s.capsulePenetrationMm);
   j["tracked_depth_max_mm"] = jsonNumber(s.trackedDepthMm);
   j["clear_frames"] = s.clearFrames;
@@ -227,8 +214,8 @@ Json summaryJson(const Summary& s, bool perFrame) {
   j["tracked_past_thin_part"] = s.hasPassCheck ? Json(s.trackedPast) : Json(nullptr);
   j["outer_active_frames"] = s.activeFrames;
   j["on_time_frames"] = s.onTimeFrames;
-  j["cost_on_ms"] = statsJson(s.costOn);
-  j["cost_off_ms"] = statsJson(s.costOff);
+  j["cost_on_ms"] = percentilesJson(s.costOn);
+  j["cost_off_ms"] = percentilesJson(s.costOff);
   j["meets_targets"] = s.meets();
   j["meets_targets_outside_keep_out"] = s.meetsByDesign();
   if (perFrame) j["per_frame"] = framesJson(s.perFrame);

@@ -48,6 +48,7 @@
 #include "io/shapes.h"
 #include "json_file.h"
 #include "mock_runtime_test.h"
+#include "percentiles.h"
 #include "sdf/sdf_grid.h"
 #include "threads_config.h"
 
@@ -63,24 +64,8 @@ double ms(Clock::duration d) {
   return std::chrono::duration<double, std::milli>(d).count();
 }
 
-struct Stats {
-  double p50 = 0, p99 = 0, max = 0;
-  size_t count = 0;
-};
-
-Stats stats(std::vector<double> v) {
-  Stats s;
-  s.count = v.size();
-  if (v.empty()) return s;
-  std::sort(v.begin(), v.end());
-  auto at = [&](double q) {
-    return v[std::min(v.size() - 1, size_t(std::ceil(q * v.size())) - 1)];
-  };
-  s.p50 = at(0.5);
-  s.p99 = at(0.99);
-  s.max = v.back();
-  return s;
-}
+using sdfg::tools::Percentiles;
+using sdfg::tools::percentiles;
 
 struct Mesh {
   std::vector<XrVector3f> vertices;
@@ -298,7 +283,7 @@ std::string scriptSqueezing() {
 }
 
 struct TwoThreads {
-  Stats locate;
+  Percentiles locate;
   size_t overlapped = 0;
   double syncMs = 0;  // median of the main thread's xrSyncActions
   bool ok = false;
@@ -376,14 +361,14 @@ TwoThreads twoThreads(int frames, uint32_t delayUs) {
   }
   render.join();
   app.gate(0);
-  out.locate = stats(locateMs);
-  out.syncMs = stats(syncMs).p50;
+  out.locate = percentiles(locateMs);
+  out.syncMs = percentiles(syncMs).p50;
   out.ok = true;
   return out;
 }
 
 struct Destroys {
-  Stats callMs;
+  Percentiles callMs;
   double wholeMs = 0;  // the work the destroy stopped, run to its end
   int trials = 0;
 };
@@ -417,7 +402,7 @@ Destroys destroyDuringSetup(const Mesh& mesh, int trials, bool instance) {
     }
     callMs.push_back(ms(Clock::now() - t0));
   }
-  out.callMs = stats(callMs);
+  out.callMs = percentiles(callMs);
   out.trials = int(callMs.size());
   return out;
 }
@@ -462,7 +447,7 @@ Destroys destroyDuringBuild(int trials, int resolution) {
     callMs.push_back(ms(Clock::now() - t0));
     app.session = XR_NULL_HANDLE;
   }
-  out.callMs = stats(callMs);
+  out.callMs = percentiles(callMs);
   out.trials = int(callMs.size());
   return out;
 }

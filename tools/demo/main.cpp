@@ -13,7 +13,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -444,15 +443,8 @@ int main(int argc, char** argv) {
       appendHand(list.lit, panels[size_t(p)].hand, kHandColour);
       for (const auto& q : panels[size_t(p)].contacts)
         appendSphere(list.overlay, q, 0.004f, kContactColour, true);
-      std::vector<uint8_t> big;
-      rendered = renderer.render(list, viewProjection, light, w * kSupersample, h * kSupersample,
-                                 kBackground, big, error);
-      if (!rendered) break;
-      const std::vector<uint8_t> small =
-          downsample(big, w * kSupersample, h * kSupersample, kSupersample);
-      const uint32_t x0 = uint32_t(p) * (w + gap);
-      for (uint32_t y = 0; y < h; ++y)
-        std::memcpy(&picture[(size_t(y) * totalW + x0) * 4], &small[size_t(y) * w * 4], w * 4);
+      rendered = renderPanel(renderer, list, viewProjection, light, w, h, kSupersample, picture,
+                             totalW, uint32_t(p) * (w + gap), 0, error);
     }
     if (!rendered) {
       fail("rendering failed: " + error);

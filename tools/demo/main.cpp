@@ -543,14 +543,9 @@ int main(int argc, char** argv) {
       std::printf("  table scene: placed on the %s: failed: %s\n", g.aim.c_str(), g.error.c_str());
   }
   if (!outerReport.frames.empty()) {
-    float tracked = 0.0f, shown = 0.0f;
-    for (const auto& f : outerReport.frames) {
-      tracked = std::min(tracked, f.trackedMm);
-      shown = std::min(shown, f.shownMm);
-    }
     std::printf("  outer hand: %zu frames, deepest in the table: tracked %.1f mm, shown %.2f mm\n",
-                outerReport.frames.size(), double(std::max(0.0f, -tracked)),
-                double(std::max(0.0f, -shown)));
+                outerReport.frames.size(), double(outerReport.deepestTrackedMm()),
+                double(outerReport.deepestShownMm()));
   }
   for (const auto& f : info.failures) std::printf("  skipped: %s\n", f.c_str());
   std::printf("Pictures (%zu PNG) and the report are in %s/\n", written.size(), dir.c_str());

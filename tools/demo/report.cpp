@@ -208,14 +208,9 @@ void writeOuter(std::ostream& md, std::ostream& html, const OuterReport& outer) 
     html << "<p class=\"fail\">The sequence did not run (see above).</p>\n";
     return;
   }
-  float deepTracked = 0.0f, deepShown = 0.0f;
-  for (const auto& f : outer.frames) {
-    deepTracked = std::min(deepTracked, f.trackedMm);
-    deepShown = std::min(deepShown, f.shownMm);
-  }
   const std::string line = "Deepest in the table: tracked hand " +
-                           num(std::max(0.0f, -deepTracked), 1) + " mm, shown hand " +
-                           num(std::max(0.0f, -deepShown), 2) + " mm.";
+                           num(outer.deepestTrackedMm(), 1) + " mm, shown hand " +
+                           num(outer.deepestShownMm(), 2) + " mm.";
   md << "![outer hand: tracked (top) and shown (bottom)](" << outer.png << ")\n\n"
      << line << "\n\n";
   html << "<p><img src=\"" << outer.png << "\" alt=\"outer hand\">\n<span class=\"caption\">"
@@ -232,6 +227,18 @@ void writeOuter(std::ostream& md, std::ostream& html, const OuterReport& outer) 
 }
 
 }  // namespace
+
+float OuterReport::deepestTrackedMm() const {
+  float least = 0.0f;
+  for (const OuterFrameRow& f : frames) least = std::min(least, f.trackedMm);
+  return std::max(0.0f, -least);  // not -0
+}
+
+float OuterReport::deepestShownMm() const {
+  float least = 0.0f;
+  for (const OuterFrameRow& f : frames) least = std::min(least, f.shownMm);
+  return std::max(0.0f, -least);  // not -0
+}
 
 bool writeReports(const std::string& dir, const std::vector<ObjectResult>& objects,
                   const SceneReport& scene, const OuterReport& outer, const ReportInfo& info,

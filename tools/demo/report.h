@@ -83,6 +83,9 @@ struct OuterReport {
   std::string png;  // empty: the sequence did not run
   std::string description;
   std::vector<OuterFrameRow> frames;
+  // How deep the tracked and the shown hand went into the table over the frames, mm (>= 0).
+  float deepestTrackedMm() const;
+  float deepestShownMm() const;
 };
 
 struct ReportInfo {

@@ -11,7 +11,9 @@
 
 #include "grasp/hand_clearance.h"
 #include "grasp/outer_hand.h"
+#include "grasp/outer_view.h"
 #include "grasp/scene_exact_source.h"
+#include "hand/hand_synthesis.h"
 #include "io/shapes.h"
 #include "png_io.h"
 #include "scene.h"
@@ -64,9 +66,8 @@ bool runOuterSequence(Renderer& renderer, const OuterSequenceOptions& options, O
   FingerCurls relaxed;
   relaxed.fill(kRelaxedCurl);
   JointPoses joints;  // wrist frame
-  model.pose(relaxed, joints);
-  std::array<float, kJointCount> radii{};
-  for (int j = 0; j < kJointCount; ++j) radii[size_t(j)] = model.jointRadius(Joint(j));
+  JointRadii radii;
+  placeJoints(model, relaxed, Pose{}, joints, radii);
   // The wrist height at which the hand's lowest point touches y = 0.
   HandParts parts;
   const int n = jointParts(joints, radii, parts);
@@ -106,14 +107,11 @@ bool runOuterSequence(Renderer& renderer, const OuterSequenceOptions& options, O
       return false;
     }
     // The shown hand: capped fingers at the model's pose at their curl, the others as given.
+    OuterNow now;
+    now.capped = r->capped;
+    now.curl = r->curl;
     JointPoses shown = joints;
-    for (int f = 0; f < kFingerCount; ++f) {
-      if (!r->capped[size_t(f)]) continue;
-      const std::span<const Joint> fj = fingerJoints(Finger(f));
-      std::array<Pose, 5> poses{};
-      model.fingerPose(Finger(f), r->curl[size_t(f)], std::span(poses.data(), fj.size()));
-      for (size_t j = 0; j < fj.size(); ++j) shown[size_t(fj[j])] = poses[j];
-    }
+    capFingers(model, now, Pose{}, shown);
     const HandPose trackedHand = toWorld(joints, radii, frames[k].tracked);
     const HandPose shownHand = toWorld(shown, radii, r->worldFromShownWrist);
     OuterFrameRow row;

@@ -116,14 +116,20 @@ void appendHand(std::vector<Vertex>& out, const HandPose& hand, const glm::vec3&
   for (int j = 0; j < kJointCount; ++j) appendSphere(out, p[j], r[j], colour, false);
 }
 
+Aabb handBounds(const HandPose& hand) {
+  Aabb b{glm::vec3(1e9f), glm::vec3(-1e9f)};
+  for (int j = 0; j < kJointCount; ++j) {
+    b.min = glm::min(b.min, hand.positions[size_t(j)] - hand.radii[size_t(j)]);
+    b.max = glm::max(b.max, hand.positions[size_t(j)] + hand.radii[size_t(j)]);
+  }
+  return b;
+}
+
 glm::mat4 graspCamera(const HandPose& hand, const Aabb& objectBounds, float aspect,
                       glm::vec3& lightOut) {
   // Frame the hand and the object near it (a big object is cut to 6 cm around the hand).
-  glm::vec3 lo(1e9f), hi(-1e9f);
-  for (int j = 0; j < kJointCount; ++j) {
-    lo = glm::min(lo, hand.positions[j] - hand.radii[j]);
-    hi = glm::max(hi, hand.positions[j] + hand.radii[j]);
-  }
+  const Aabb handBox = handBounds(hand);
+  glm::vec3 lo = handBox.min, hi = handBox.max;
   const glm::vec3 objLo = glm::max(objectBounds.min, lo - 0.06f);
   const glm::vec3 objHi = glm::min(objectBounds.max, hi + 0.06f);
   if (glm::all(glm::lessThan(objLo, objHi))) {

@@ -42,6 +42,9 @@ void appendSphere(std::vector<Vertex>& out, const glm::vec3& centre, float radiu
 // Bones as tapered capsules from joint to joint with the joints' radii, and the palm.
 void appendHand(std::vector<Vertex>& out, const HandPose& hand, const glm::vec3& colour);
 
+// The box around the hand's joint spheres (world).
+Aabb handBounds(const HandPose& hand);
+
 // View-projection (Vulkan clip space) of a picture of `hand` holding an object with world
 // bounds `objectBounds`: seen from in front of the fingers, on the thumb side.
 glm::mat4 graspCamera(const HandPose& hand, const Aabb& objectBounds, float aspect,

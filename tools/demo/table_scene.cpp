@@ -63,15 +63,6 @@ std::string nameOf(const std::vector<Object>& objects, uint64_t id) {
   return id == 0 ? "nothing" : "target " + std::to_string(id);
 }
 
-Aabb handBounds(const HandPose& hand) {
-  Aabb b{glm::vec3(1e9f), glm::vec3(-1e9f)};
-  for (int j = 0; j < kJointCount; ++j) {
-    b.min = glm::min(b.min, hand.positions[size_t(j)] - hand.radii[size_t(j)]);
-    b.max = glm::max(b.max, hand.positions[size_t(j)] + hand.radii[size_t(j)]);
-  }
-  return b;
-}
-
 // One squeeze of the right hand at `worldFromWrist`, until the session shows a grasp (or the
 // bound passes), then the release.
 Grasp graspOnce(GraspSession& session, const std::vector<Object>& objects,

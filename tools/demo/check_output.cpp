@@ -41,10 +41,11 @@ struct Counts {
          grey = 0;
 };
 
+// Over columns [x0, x1) of rows [y0, y0 + height) of a picture `width` pixels wide.
 Counts count(const std::vector<uint8_t>& rgba, uint32_t width, uint32_t x0, uint32_t x1,
-             uint32_t height) {
+             uint32_t height, uint32_t y0 = 0) {
   Counts c;
-  for (uint32_t y = 0; y < height; ++y) {
+  for (uint32_t y = y0; y < y0 + height; ++y) {
     for (uint32_t x = x0; x < x1; ++x) {
       const uint8_t* p = &rgba[(size_t(y) * width + x) * 4];
       const int r = p[0], g = p[1], b = p[2];
@@ -132,8 +133,7 @@ void checkOuter(const std::string& dir, uint32_t w, const std::string& md,
     for (uint32_t col = 0; col < 5; ++col) {
       const uint32_t x0 = col * (p + 4);
       const Counts top = count(rgba, totalW, x0, x0 + p, p);
-      std::vector<uint8_t> bottomRows(rgba.begin() + size_t(p + 4) * totalW * 4, rgba.end());
-      const Counts bottom = count(bottomRows, totalW, x0, x0 + p, p);
+      const Counts bottom = count(rgba, totalW, x0, x0 + p, p, p + 4);
       const std::string name = "outer hand column " + std::to_string(col);
       check(top.grey > top.pixels / 200 && top.hand == 0,
             name + ": tracked hand grey (" + std::to_string(top.grey) + " px), no skin tone");
@@ -183,22 +183,13 @@ int main(int argc, char** argv) {
   check(rows == objects.size() * 16,
         "report.md: 15 finger rows per object (" + std::to_string(rows) + " table rows)");
   for (const auto& o : objects) {
-    for (const std::string& png : {o + "-grasp.png", o + "-sdf-slice.png"}) {
-      check(md.find("(" + png + ")") != std::string::npos, "report.md shows " + png);
-      check(html.find("src=\"" + png + "\"") != std::string::npos, "report.html shows " + png);
-    }
-    uint32_t pw = 0, ph = 0;
+    for (const std::string& png : {o + "-grasp.png", o + "-sdf-slice.png"})
+      checkShown(png, md, html);
     std::vector<uint8_t> rgba;
-    std::string error;
-    const bool read = sdfg::demo::readPng(dir + "/" + o + "-grasp.png", pw, ph, rgba, error);
-    check(read, o + "-grasp.png readable " + error);
-    if (read) {
-      check(pw == 3 * w + 8 && ph == w, o + "-grasp.png is " + std::to_string(3 * w + 8) + "x" +
-                                            std::to_string(w) + " (got " + std::to_string(pw) +
-                                            "x" + std::to_string(ph) + ")");
+    if (readPicture(dir, o + "-grasp.png", 3 * w + 8, w, rgba)) {
       size_t magenta = 0;
-      for (uint32_t p = 0; p < 3 && pw == 3 * w + 8; ++p) {
-        const Counts c = count(rgba, pw, p * (w + 4), p * (w + 4) + w, ph);
+      for (uint32_t p = 0; p < 3; ++p) {
+        const Counts c = count(rgba, 3 * w + 8, p * (w + 4), p * (w + 4) + w, w);
         const std::string name = o + " panel " + std::to_string(p);
         check(c.colours.size() > 200, name + ": " + std::to_string(c.colours.size()) + " colours");
         check(c.hand > c.pixels / 100, name + ": hand colour on " + std::to_string(c.hand) + " px");
@@ -208,12 +199,8 @@ int main(int argc, char** argv) {
       }
       check(magenta > 0, o + ": contact markers (" + std::to_string(magenta) + " px)");
     }
-    const bool readSlice =
-        sdfg::demo::readPng(dir + "/" + o + "-sdf-slice.png", pw, ph, rgba, error);
-    check(readSlice, o + "-sdf-slice.png readable " + error);
-    if (readSlice) {
-      check(pw == w && ph == w, o + "-sdf-slice.png is " + std::to_string(w) + " square");
-      const Counts c = count(rgba, pw, 0, pw, ph);
+    if (readPicture(dir, o + "-sdf-slice.png", w, w, rgba)) {
+      const Counts c = count(rgba, w, 0, w, w);
       check(c.blue > 0 && c.red > c.pixels / 4 && c.black > 0,
             o + " slice: inside blue, outside red, black surface");
     }

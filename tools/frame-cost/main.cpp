@@ -272,7 +272,6 @@ class App {
       XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG, &setup};
       timed("xrGetGraspStateSDFG", [&] { state_(session_, &gi, &st); });
       grasping_ = st.isGrasping == XR_TRUE;
-      ready_ = setup.readyCount > 0;
       readyCount_ = setup.readyCount;
       const XrPosef& o = offset.offset;
       handMoved_ = o.position.x != 0.0f || o.position.y != 0.0f || o.position.z != 0.0f ||
@@ -306,7 +305,7 @@ class App {
   }
 
   bool grasping() const { return grasping_; }
-  bool ready() const { return ready_; }
+  bool ready() const { return readyCount_ > 0; }
   uint32_t readyCount() const { return readyCount_; }
   // The frame's XrGraspHandOffsetSDFG::offset (right hand) was not the identity.
   bool handMoved() const { return handMoved_; }
@@ -366,7 +365,6 @@ class App {
   bool running_ = false;
   uint64_t framesEnded_ = 0;
   bool grasping_ = false;
-  bool ready_ = false;
   uint32_t readyCount_ = 0;
   bool handMoved_ = false;
   std::vector<XrGraspTargetSDFG> others_;  // addTarget()'s
@@ -623,10 +621,7 @@ int main(int argc, char** argv) {
     r.error = !r.off.ok ? "layer off: " + r.off.error : !r.on.ok ? "layer on: " + r.on.error : "";
     for (int p = 0; p < kPhaseCount; ++p) {
       r.offStats[p] = percentiles(r.off.frameMs[p]);
-      r.offMedian[p] = r.offStats[p].p50;
-      std::vector<double> added;
-      for (double v : r.on.frameMs[p]) added.push_back(v - r.offMedian[p]);
-      r.added[p] = percentiles(added);
+      r.added[p] = addedOver(r.on.frameMs[p], r.offStats[p].p50);
     }
     results.push_back(std::move(r));
   }
@@ -682,13 +677,8 @@ int main(int argc, char** argv) {
                                      : "";
     for (int p = 0; p < kOuterPhaseCount; ++p) {
       r.offStats[p] = percentiles(r.off.frameMs[p]);
-      r.offMedian[p] = r.offStats[p].p50;
-      std::vector<double> added;
-      for (double v : r.on.frameMs[p]) added.push_back(v - r.offMedian[p]);
-      r.added[p] = percentiles(added);
-      added.clear();
-      for (double v : r.onWithoutOuter.frameMs[p]) added.push_back(v - r.offMedian[p]);
-      r.addedWithoutOuter[p] = percentiles(added);
+      r.added[p] = addedOver(r.on.frameMs[p], r.offStats[p].p50);
+      r.addedWithoutOuter[p] = addedOver(r.onWithoutOuter.frameMs[p], r.offStats[p].p50);
     }
     std::printf(
         "\nThe outer hand: time the layer adds per frame (ms), open hand near, then pressed into "

@@ -9,13 +9,13 @@ namespace sdfg::frame_cost {
 namespace {
 
 // A phase's time added by the layer, beside the layer-off run's own frame totals.
-tools::Json phaseJson(const Percentiles& added, double offMedian, const Percentiles& off) {
+tools::Json phaseJson(const Percentiles& added, const Percentiles& off) {
   using tools::jsonNumber;
   return {{"frames", added.count},
           {"added_p50_ms", jsonNumber(added.p50)},
           {"added_p99_ms", jsonNumber(added.p99)},
           {"added_max_ms", jsonNumber(added.max)},
-          {"off_median_ms", jsonNumber(offMedian)},
+          {"off_median_ms", jsonNumber(off.p50)},
           {"off_p99_ms", jsonNumber(off.p99)},
           {"off_max_ms", jsonNumber(off.max)}};
 }
@@ -34,6 +34,13 @@ tools::Json callsJson(const std::map<std::string, std::vector<double>>& callMs) 
 }
 
 }  // namespace
+
+Percentiles addedOver(const std::vector<double>& frameMs, double offMedianMs) {
+  std::vector<double> added;
+  added.reserve(frameMs.size());
+  for (double v : frameMs) added.push_back(v - offMedianMs);
+  return percentiles(std::move(added));
+}
 
 tools::Json resultsJson(const std::vector<MeshResult>& results, int phaseFrames,
                         double framePeriodMs, const std::vector<std::string>& skipped,
@@ -60,7 +67,7 @@ tools::Json resultsJson(const std::vector<MeshResult>& results, int phaseFrames,
     m["grab_latency_frames"] = r.on.grabLatencyFrames;
     Json& phases = m["phases"] = Json::object();
     for (int p = 0; p < kPhaseCount; ++p) {
-      Json& phase = phases[kPhases[p]] = phaseJson(r.added[p], r.offMedian[p], r.offStats[p]);
+      Json& phase = phases[kPhases[p]] = phaseJson(r.added[p], r.offStats[p]);
       phase["cpu_builds"] = r.on.builds[p];
     }
     m["calls_on"] = callsJson(r.on.callMs);
@@ -78,7 +85,7 @@ tools::Json resultsJson(const std::vector<MeshResult>& results, int phaseFrames,
     o["setup_ms"] = jsonNumber(r.on.setupMs);
     Json& phases = o["phases"] = Json::object();
     for (int p = 0; p < kOuterPhaseCount; ++p) {
-      Json& phase = phases[kOuterPhases[p]] = phaseJson(r.added[p], r.offMedian[p], r.offStats[p]);
+      Json& phase = phases[kOuterPhases[p]] = phaseJson(r.added[p], r.offStats[p]);
       phase["hand_moved_frames"] = r.on.movedFrames[p];
       phase["outer_hand_off_added_p50_ms"] = jsonNumber(r.addedWithoutOuter[p].p50);
       phase["outer_hand_off_added_p99_ms"] = jsonNumber(r.addedWithoutOuter[p].p99);

@@ -47,7 +47,6 @@ struct MeshResult {
   std::string error;
   RunResult on, off;
   std::array<Percentiles, kPhaseCount> added;
-  std::array<double, kPhaseCount> offMedian{};
   std::array<Percentiles, kPhaseCount> offStats;  // the layer-off run's own frame totals
 };
 
@@ -78,9 +77,12 @@ struct OuterResult {
   // switched off (its configuration's outer_hand): the outer hand's own share.
   OuterRun on, off, onWithoutOuter;
   std::array<Percentiles, kOuterPhaseCount> added, addedWithoutOuter;
-  std::array<double, kOuterPhaseCount> offMedian{};
   std::array<Percentiles, kOuterPhaseCount> offStats;
 };
+
+// What the layer adds per frame: each of `frameMs` (layer on) less `offMedianMs` (the layer-off
+// run's median of the same phase).
+Percentiles addedOver(const std::vector<double>& frameMs, double offMedianMs);
 
 // The results as JSON: the settings, the provenance of the build (json_file.h), the objects
 // skipped (not found or unreadable), and per object its calls, set-up, grab latency and, per

@@ -49,30 +49,23 @@ OuterScene outerScene(int room) {
   const TriangleMesh box = makeBox(glm::vec3(0.05f));
   const TriangleMesh ball = makeSphere(0.03f, 1);
   // A grid fine enough for `room` places outside the hand's metre, three shelves high.
-  int side = 2;
   auto places = [&](int n) {
-    int count = 0;
+    std::vector<glm::vec3> out;
     for (int y = 0; y < 3; ++y)
       for (int i = 0; i < n; ++i)
         for (int k = 0; k < n; ++k) {
           const glm::vec3 c(-5.0f + 10.0f * (float(i) + 0.5f) / float(n), 0.5f + float(y),
                             -5.0f + 10.0f * (float(k) + 0.5f) / float(n));
-          if (glm::length(c - palm) >= 1.0f) ++count;
+          if (glm::length(c - palm) >= 1.0f) out.push_back(c);
         }
-    return count;
+    return out;
   };
-  const int rest = std::max(0, room - s.inHandBox);
-  while (places(side) < rest) ++side;
-  int added = 0;
-  for (int y = 0; y < 3 && added < rest; ++y)
-    for (int i = 0; i < side && added < rest; ++i)
-      for (int k = 0; k < side && added < rest; ++k) {
-        const glm::vec3 c(-5.0f + 10.0f * (float(i) + 0.5f) / float(side), 0.5f + float(y),
-                          -5.0f + 10.0f * (float(k) + 0.5f) / float(side));
-        if (glm::length(c - palm) < 1.0f) continue;
-        place(meshObject(added % 2 == 0 ? "box" : "ball", added % 2 == 0 ? box : ball), c);
-        ++added;
-      }
+  const size_t rest = size_t(std::max(0, room - s.inHandBox));
+  int side = 2;
+  std::vector<glm::vec3> centres = places(side);
+  while (centres.size() < rest) centres = places(++side);
+  for (size_t added = 0; added < rest; ++added)
+    place(meshObject(added % 2 == 0 ? "box" : "ball", added % 2 == 0 ? box : ball), centres[added]);
   return s;
 }
 

@@ -112,9 +112,11 @@ RunRecord runTrajectory(const Trajectory& trajectory, const TrackedHand& hand,
     r.onTime = view.outer.active && resolveOuter(view.outer).onTime;
     r.shownClearance = smallestClearance(shown, hand.radii, trajectory.objects);
     r.trackedClearance = smallestClearance(tracked, hand.radii, trajectory.objects);
-    r.shownPartClearance = smallestPartClearance(shown, hand.radii, trajectory.objects);
-    r.trackedPartClearance = smallestPartClearance(tracked, hand.radii, trajectory.objects);
-    r.trackedKeepOut = smallestPartClearance(tracked, hand.radii, trajectory.objects, true);
+    r.shownPartClearance = smallestPartClearance(shown, hand.radii, trajectory.objects).radius;
+    const PartClearance trackedParts =
+        smallestPartClearance(tracked, hand.radii, trajectory.objects);
+    r.trackedPartClearance = trackedParts.radius;
+    r.trackedKeepOut = trackedParts.cover;
     r.identical = true;
     for (int j = 0; j < kJointCount; ++j) {
       const Pose& a = shown[size_t(j)];

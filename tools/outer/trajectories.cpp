@@ -155,15 +155,19 @@ float smallestClearance(const JointPoses& joints, const std::array<float, kJoint
   return c;
 }
 
-float smallestPartClearance(const JointPoses& joints, const std::array<float, kJointCount>& radii,
-                            const std::vector<SceneObject>& objects, bool cover) {
+PartClearance smallestPartClearance(const JointPoses& joints,
+                                    const std::array<float, kJointCount>& radii,
+                                    const std::vector<SceneObject>& objects) {
   HandParts parts;
   const int n = jointParts(joints, radii, parts);
-  float c = std::numeric_limits<float>::infinity();
+  PartClearance c{std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity()};
   for (const SceneObject& o : objects)
-    for (int i = 0; i < n; ++i)
-      c = std::min(c, o.signedDistance(parts[size_t(i)].centre) -
-                          (cover ? parts[size_t(i)].coverRadius : parts[size_t(i)].radius));
+    for (int i = 0; i < n; ++i) {
+      const HandPart& part = parts[size_t(i)];
+      const float d = o.signedDistance(part.centre);
+      c.radius = std::min(c.radius, d - part.radius);
+      c.cover = std::min(c.cover, d - part.coverRadius);
+    }
   return c;
 }
 

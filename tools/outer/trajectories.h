@@ -72,10 +72,15 @@ float smallestClearance(const JointPoses& joints, const std::array<float, kJoint
                         const std::vector<SceneObject>& objects);
 
 // The same over the hand's bone capsules as the engine covers them (grasp/hand_clearance.h's
-// jointParts: spheres along every bone, with their radii). `cover`: with the radii grown to
-// cover the capsules between the spheres (HandPart::coverRadius), as the outer hand keeps them out.
-float smallestPartClearance(const JointPoses& joints, const std::array<float, kJointCount>& radii,
-                            const std::vector<SceneObject>& objects, bool cover = false);
+// jointParts: spheres along every bone): over their radii, and over the radii grown to cover the
+// capsules between the spheres (HandPart::coverRadius), as the outer hand keeps them out.
+struct PartClearance {
+  float radius = 0.0f;
+  float cover = 0.0f;
+};
+PartClearance smallestPartClearance(const JointPoses& joints,
+                                    const std::array<float, kJointCount>& radii,
+                                    const std::vector<SceneObject>& objects);
 
 // Every trajectory of the benchmark, for `hand`. `scale` (0, 1] shortens holds and slides (the
 // smoke test); speeds and depths stay.

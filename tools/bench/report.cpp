@@ -40,11 +40,7 @@ struct Column {
   std::string key;  // top-level member of a row
   std::string sub;  // member of that object, or empty for a plain number
   std::string title() const { return sub.empty() ? key : key + " " + sub; }
-  double get(const Json& row) const {
-    const Json* v = member(row, key);
-    if (v && !sub.empty()) v = member(*v, sub);
-    return numberOf(v);
-  }
+  double get(const Json& row) const { return numberAt(row, key, sub); }
 };
 
 // A method as run on one SDF backend ("none": a physics method, no field).

@@ -23,6 +23,8 @@ const Json* member(const Json& j, const std::string& key);
 double numberOf(const Json* j);
 // A string's value; "" for anything else, nullptr included.
 std::string stringOf(const Json* j);
+// The number at row[key][sub] (row[key] when `sub` is empty); NaN when any step is missing.
+double numberAt(const Json& row, const std::string& key, const std::string& sub = {});
 
 // Three significant digits, but whole numbers from 1000 up (no "1.1e+04" in a table).
 std::string fmt(double v);

@@ -21,6 +21,12 @@ std::string stringOf(const Json* j) {
   return j && j->is_string() ? j->get<std::string>() : std::string();
 }
 
+double numberAt(const Json& row, const std::string& key, const std::string& sub) {
+  const Json* v = member(row, key);
+  if (v && !sub.empty()) v = member(*v, sub);
+  return numberOf(v);
+}
+
 std::string fmt(double v) {
   if (!std::isfinite(v)) return "-";
   char buf[48];

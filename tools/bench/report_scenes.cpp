@@ -1,6 +1,5 @@
 // The report's scenes section (autograsp-bench --scenes): one table per run, rows by scene and
 // method, read from the JSON's "scenes" array as the rest of the report is.
-#include <cmath>
 #include <sstream>
 
 #include "report_detail.h"
@@ -10,10 +9,6 @@ namespace sdfg::bench {
 std::string scenesSection(const Json& results) {
   const Json* scenes = member(results, "scenes");
   if (!scenes || !scenes->is_array() || scenes->empty()) return {};
-  auto sub = [](const Json& row, const char* key, const char* part) {
-    const Json* object = member(row, key);
-    return object ? numberOf(member(*object, part)) : std::nan("");
-  };
   std::ostringstream md;
   md << "## Scenes\n\n"
      << "Every method with other objects around the one the hand reaches for (`--scenes`; "
@@ -32,15 +27,15 @@ std::string scenesSection(const Json& results) {
     const std::string scene = stringOf(member(row, "scene"));
     md << "| " << (scene == lastScene ? std::string() : "`" + scene + "`") << " | "
        << stringOf(member(row, "method")) << " | " << fmt(numberOf(member(row, "grasps"))) << " | "
-       << fmt(sub(row, "other_penetration_mm", "p99")) << " | "
-       << fmt(sub(row, "other_penetration_mm", "max")) << " | "
+       << fmt(numberAt(row, "other_penetration_mm", "p99")) << " | "
+       << fmt(numberAt(row, "other_penetration_mm", "max")) << " | "
        << fmt(numberOf(member(row, "wrong_object"))) << " / "
        << fmt(numberOf(member(row, "facing_graspable"))) << " | "
        << fmt(numberOf(member(row, "held_nothing"))) << " | "
        << fmt(numberOf(member(row, "contacts_mean"))) << " | "
-       << fmt(sub(row, "contact_residual_mm", "median")) << " | "
-       << fmt(sub(row, "contact_residual_mm", "p95")) << " | "
-       << fmt(sub(row, "penetration_mm", "max")) << " | "
+       << fmt(numberAt(row, "contact_residual_mm", "median")) << " | "
+       << fmt(numberAt(row, "contact_residual_mm", "p95")) << " | "
+       << fmt(numberAt(row, "penetration_mm", "max")) << " | "
        << fmt(numberOf(member(row, "early_stops"))) << " | "
        << fmt(numberOf(member(row, "pass_through"))) << " |\n";
     lastScene = scene;

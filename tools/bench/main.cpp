@@ -167,7 +167,7 @@ int main(int argc, char** argv) {
                    "note: --scenes without ../shared/meshes: the research meshes' table scenes "
                    "are skipped\n");
     }
-    sceneRows = runScenes(scenes, o, threads, failed);
+    sceneRows = runScenes(scenes, o, box, threads, failed);
     printSceneTable(sceneRows);
   }
   if (o.approaching) {

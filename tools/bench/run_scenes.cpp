@@ -8,7 +8,15 @@
 namespace sdfg::bench {
 
 std::vector<SceneRow> runScenes(const std::vector<BenchScene>& scenes, const Options& o,
-                                unsigned threads, bool& failed) {
+                                const GridBox& box, unsigned threads, bool& failed) {
+  SceneRun run;
+  run.placements = o.placements;
+  run.seed = o.seed;
+  run.threads = threads;
+  run.options.da = o.da;
+  run.options.clearance = o.clearHand;
+  run.exactCheck = o.exactCheck;
+  run.box = box;
   std::vector<SceneRow> rows;
   for (const BenchScene& scene : scenes) {
     std::string objects;
@@ -17,16 +25,7 @@ std::vector<SceneRow> runScenes(const std::vector<BenchScene>& scenes, const Opt
       objects += obj.name + (obj.graspable ? " (graspable)" : " (scene)");
     }
     for (const std::string& method : o.methods) {
-      SceneRun run;
       run.method = method;
-      run.placements = o.placements;
-      run.seed = o.seed;
-      run.threads = threads;
-      run.options.da = o.da;
-      run.options.clearance = o.clearHand;
-      run.exactCheck = o.exactCheck;
-      run.box = GridBox::referenceDefault();
-      run.box.resolution = glm::uvec3(uint32_t(o.resolution));
       const auto t0 = std::chrono::steady_clock::now();
       const Result<SceneFigures> figures = measureScene(scene, run);
       if (!figures) {

@@ -21,10 +21,10 @@ struct SceneRow {
   SceneFigures figures;
 };
 
-// Every method of `o` in every scene; a scene or method that fails is reported on stderr and
-// sets `failed`, the others still run.
+// Every method of `o` in every scene, on the grab box `box`; a scene or method that fails is
+// reported on stderr and sets `failed`, the others still run.
 std::vector<SceneRow> runScenes(const std::vector<BenchScene>& scenes, const Options& o,
-                                unsigned threads, bool& failed);
+                                const GridBox& box, unsigned threads, bool& failed);
 
 void printSceneTable(const std::vector<SceneRow>& rows);
 

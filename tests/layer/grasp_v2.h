@@ -6,12 +6,14 @@
 #include <catch2/catch.hpp>
 
 #include <chrono>
+#include <limits>
 #include <memory>
 #include <string>
 
 #include <glm/gtc/quaternion.hpp>
 
 #include "grasp_checks.h"
+#include "scene/analytic_shape.h"
 #include "test_scenes.h"
 #include "xr_harness.h"
 
@@ -75,7 +77,7 @@ inline OpenRightHand openRightHand(const XrPosef& grip) {
   const glm::vec3 across =
       open[int(Joint::little_proximal)].position - open[int(Joint::index_proximal)].position;
   return {localFromWrist.transformPoint(palm.position),
-          localFromWrist.transformVector(palm.orientation * glm::vec3(0, -1, 0)),
+          localFromWrist.transformVector(palmFacing(palm)),
           glm::normalize(localFromWrist.transformVector(across)),
           localFromWrist.transformPoint(open[int(Joint::middle_proximal)].position)};
 }
@@ -108,6 +110,49 @@ inline XrPosef belowOpenRightPalm(const TestMesh& mesh, const XrPosef& grip,
   }
   FAIL("no placement under the open palm keeps the hand clear of the mesh");
   return {};
+}
+
+// An orientation whose +Y points out of the open right hand's palm side toward the palm (so a
+// box placed with it lies flat under the palm) and +X across the fingers.
+inline XrQuaternionf facingPalm(const XrPosef& grip) {
+  const OpenRightHand hand = openRightHand(grip);
+  const glm::vec3 y = -hand.down;
+  const glm::vec3 x = glm::normalize(hand.across - glm::dot(hand.across, y) * y);
+  const glm::quat q = glm::quat_cast(glm::mat3(x, y, glm::cross(x, y)));
+  return {q.x, q.y, q.z, q.w};
+}
+
+// The pose of a box of half extents `half` lying flat under the open right hand (facingPalm()),
+// its +Y face 3 mm clear of the hand (belowOpenRightPalm()).
+inline XrPosef boxUnderPalm(const XrPosef& grip, const XrVector3f& half) {
+  const TestMesh box = toTestMesh(makeBox(2.0f * glm::vec3(half.x, half.y, half.z)));
+  return belowOpenRightPalm(box, grip, facingPalm(grip));
+}
+
+// The deepest any joint sphere of the located hand is inside `box` placed at `pose` (LOCAL),
+// metres; negative when the hand is clear: its smallest clearance.
+inline float depthInBox(const Joints& joints, const AnalyticShape& box, const XrPosef& pose) {
+  const Pose boxFromLocal = toPose(pose).inverse();
+  float deepest = -std::numeric_limits<float>::infinity();
+  for (const XrHandJointLocationEXT& j : joints.joints) {
+    const glm::vec3 p = boxFromLocal.transformPoint(
+        glm::vec3(j.pose.position.x, j.pose.position.y, j.pose.position.z));
+    deepest = std::max(deepest, j.radius - box.signedDistance(p));
+  }
+  return deepest;
+}
+
+// Creates an analytic shape target of `role` at `pose` (LOCAL).
+inline XrGraspTargetSDFG makeShapeTarget(const App& app, const Ext& ext, XrGraspShapeTypeSDFG type,
+                                         const XrVector3f& half, const XrPosef& pose,
+                                         XrGraspTargetRoleSDFG role) {
+  XrGraspTargetShapeSDFG shape{XR_TYPE_GRASP_TARGET_SHAPE_SDFG, nullptr, type, half};
+  XrGraspTargetRoleInfoSDFG r{XR_TYPE_GRASP_TARGET_ROLE_SDFG, &shape, role};
+  XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &r};
+  ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, app.local, pose};
+  XrGraspTargetSDFG t = XR_NULL_HANDLE;
+  REQUIRE(ext.create(app.session, &ci, &t) == XR_SUCCESS);
+  return t;
 }
 
 // The procedural mug's pose in layer_grasp.tests.cpp's mug scene: handle toward the palm, its bar

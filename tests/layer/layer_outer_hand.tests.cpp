@@ -38,25 +38,12 @@ struct Slab {
 };
 
 Slab slabUnderPalm(const XrVector3f& half) {
-  const OpenRightHand hand = openRightHand(kGrip);
-  const glm::vec3 y = -hand.down;
-  const glm::vec3 x = glm::normalize(hand.across - glm::dot(hand.across, y) * y);
-  const glm::quat q = glm::quat_cast(glm::mat3(x, y, glm::cross(x, y)));
-  const TestMesh mesh = toTestMesh(makeBox(2.0f * glm::vec3(half.x, half.y, half.z)));
-  return {belowOpenRightPalm(mesh, kGrip, {q.x, q.y, q.z, q.w}), half};
+  return {boxUnderPalm(kGrip, half), half};
 }
 
 // The deepest any joint sphere is inside the slab (negative: the smallest clearance), metres.
 float depthIn(const Joints& j, const Slab& slab) {
-  const Pose fromLocal = toPose(slab.pose).inverse();
-  const AnalyticShape box = slab.shape();
-  float deepest = -1.0f;
-  for (const XrHandJointLocationEXT& l : j.joints) {
-    const glm::vec3 p = fromLocal.transformPoint(
-        glm::vec3(l.pose.position.x, l.pose.position.y, l.pose.position.z));
-    deepest = std::max(deepest, l.radius - box.signedDistance(p));
-  }
-  return deepest;
+  return depthInBox(j, slab.shape(), slab.pose);
 }
 
 float largestMotion(const Joints& a, const Joints& b) {
@@ -107,14 +94,8 @@ std::vector<Frame> drive(const Slab& slab, const std::vector<XrPosef>& grips, Pr
   REQUIRE(app.ok());
   Ext ext(app);
   const XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
-  XrGraspTargetShapeSDFG shape{XR_TYPE_GRASP_TARGET_SHAPE_SDFG, nullptr,
-                               XR_GRASP_SHAPE_TYPE_BOX_SDFG, slab.half};
-  XrGraspTargetRoleInfoSDFG role{XR_TYPE_GRASP_TARGET_ROLE_SDFG, &shape,
-                                 XR_GRASP_TARGET_ROLE_SCENE_SDFG};
-  XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &role};
-  ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, app.local, slab.pose};
-  XrGraspTargetSDFG target = XR_NULL_HANDLE;
-  REQUIRE(ext.create(app.session, &ci, &target) == XR_SUCCESS);
+  makeShapeTarget(app, ext, XR_GRASP_SHAPE_TYPE_BOX_SDFG, slab.half, slab.pose,
+                  XR_GRASP_TARGET_ROLE_SCENE_SDFG);
   REQUIRE(app.framesUntil([&] { return app.framesEnded >= 3; }));
   prepare(app, ext);
   std::string script;

@@ -20,13 +20,7 @@ const XrPosef kGrip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
 
 XrGraspTargetSDFG makeShape(const GraspRun& run, XrGraspShapeTypeSDFG type, const XrVector3f& half,
                             const XrPosef& pose, XrGraspTargetRoleSDFG role) {
-  XrGraspTargetShapeSDFG shape{XR_TYPE_GRASP_TARGET_SHAPE_SDFG, nullptr, type, half};
-  XrGraspTargetRoleInfoSDFG r{XR_TYPE_GRASP_TARGET_ROLE_SDFG, &shape, role};
-  XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &r};
-  ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, run.app->local, pose};
-  XrGraspTargetSDFG t = XR_NULL_HANDLE;
-  REQUIRE(run.ext->create(run.app->session, &ci, &t) == XR_SUCCESS);
-  return t;
+  return makeShapeTarget(*run.app, *run.ext, type, half, pose, role);
 }
 
 void setRole(const GraspRun& run, XrGraspTargetSDFG target, XrGraspTargetRoleSDFG role,
@@ -59,29 +53,6 @@ std::map<XrGraspTargetSDFG, int> fingersOn(const XrGraspTouchesSDFG& t) {
   return out;
 }
 
-// The deepest any joint sphere of the located hand is inside an axis-aligned box (LOCAL), metres
-// (0: none inside).
-float deepestInBox(const Joints& joints, const AnalyticShape& box, const XrPosef& pose) {
-  const Pose boxFromLocal = toPose(pose).inverse();
-  float deepest = 0.0f;
-  for (const XrHandJointLocationEXT& j : joints.joints) {
-    const glm::vec3 p = boxFromLocal.transformPoint(
-        glm::vec3(j.pose.position.x, j.pose.position.y, j.pose.position.z));
-    deepest = std::max(deepest, j.radius - box.signedDistance(p));
-  }
-  return deepest;
-}
-
-// An orientation whose +Y points out of the open right hand's palm side toward the palm (so a
-// box placed with it lies flat under the palm) and +X across the fingers.
-XrQuaternionf facingPalm(const XrPosef& grip) {
-  const OpenRightHand hand = openRightHand(grip);
-  const glm::vec3 y = -hand.down;
-  const glm::vec3 x = glm::normalize(hand.across - glm::dot(hand.across, y) * y);
-  const glm::quat q = glm::quat_cast(glm::mat3(x, y, glm::cross(x, y)));
-  return {q.x, q.y, q.z, q.w};
-}
-
 // A table top (a box) whose top face is just under the open right hand's palm side, 3 mm clear of
 // it, centred under the palm: the pose of its centre, its half extents.
 struct Table {
@@ -90,9 +61,8 @@ struct Table {
 };
 
 Table tableUnderPalm(const XrPosef& grip) {
-  const TestMesh slab = toTestMesh(makeBox(glm::vec3(0.6f, 0.04f, 0.6f)));
   Table t;
-  t.pose = belowOpenRightPalm(slab, grip, facingPalm(grip));
+  t.pose = boxUnderPalm(grip, t.half);
   return t;
 }
 
@@ -123,8 +93,8 @@ TEST_CASE("A squeeze with only scene geometry in reach closes on it and holds no
   CHECK(on.size() == 1);
   Joints joints;
   REQUIRE(locateJoints(*run.app, run.tracker, joints) == XR_SUCCESS);
-  CHECK(deepestInBox(joints, {ShapeKind::box, {table.half.x, table.half.y, table.half.z}},
-                     table.pose) <= 0.001f);
+  CHECK(depthInBox(joints, {ShapeKind::box, {table.half.x, table.half.y, table.half.z}},
+                   table.pose) <= 0.001f);
   CHECK(validationLog().empty());
 }
 
@@ -160,8 +130,8 @@ TEST_CASE("A flat object on a table: the grab takes the object, no hand part ent
   }
   Joints joints;
   REQUIRE(locateJoints(*run.app, run.tracker, joints) == XR_SUCCESS);
-  CHECK(deepestInBox(joints, {ShapeKind::box, {table.half.x, table.half.y, table.half.z}},
-                     table.pose) <= 0.001f);
+  CHECK(depthInBox(joints, {ShapeKind::box, {table.half.x, table.half.y, table.half.z}},
+                   table.pose) <= 0.001f);
   CHECK(validationLog().empty());
 }
 

@@ -49,8 +49,7 @@ struct Rig {
     s.solver = "ours";
     s.outerHand = outer;
     REQUIRE(session.configure(s) == Status::ok);
-    model.pose(FingerCurls{}, local);
-    for (int j = 0; j < kJointCount; ++j) radii[size_t(j)] = model.jointRadius(Joint(j));
+    placeJoints(model, FingerCurls{}, Pose{}, local, radii);
   }
   void addShape(uint64_t id, const AnalyticShape& shape, const Pose& worldFromShape,
                 TargetRole role = TargetRole::scene) {
@@ -61,12 +60,8 @@ struct Rig {
   void addMesh(uint64_t id, TriangleMesh mesh, const Pose& worldFromObject) {
     REQUIRE(session.addTarget(id, std::move(mesh)) == Status::ok);
     targets.push_back({id, true, worldFromObject});
-    const auto deadline = std::chrono::steady_clock::now() + 30s;
-    while (session.targetSetup(id) != TargetSetup::ready) {
-      REQUIRE(session.targetSetup(id) != TargetSetup::failed);
-      REQUIRE(std::chrono::steady_clock::now() < deadline);
-      std::this_thread::sleep_for(1ms);
-    }
+    REQUIRE(session.waitWorkerIdle(30s));
+    REQUIRE(session.targetSetup(id) == TargetSetup::ready);
   }
   JointPoses tracked(const Pose& wrist) const {
     JointPoses world;

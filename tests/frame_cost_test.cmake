@@ -3,6 +3,7 @@
 # has every key docs/benchmarks.md quotes and the commit of the code, and that a bad option value
 # is a usage error; timings are the benchmark's business, not a test's.
 # Inputs: -DTOOL=<autograsp-frame-cost> -DWORK=<scratch folder>
+include(${CMAKE_CURRENT_LIST_DIR}/json_checks.cmake)
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 execute_process(COMMAND ${TOOL} --embedded-only --only mug --frames 5 --json ${WORK}/fc.json
@@ -18,49 +19,29 @@ string(JSON n LENGTH "${json}" meshes)
 if(NOT n EQUAL 1)
   message(FATAL_ERROR "expected 1 mesh in the JSON, got ${n}")
 endif()
-foreach(key frames_per_phase frame_period_ms hardware_threads skipped provenance)
-  string(JSON v ERROR_VARIABLE e GET "${json}" ${key})
-  if(e)
-    message(FATAL_ERROR "JSON lacks ${key}: ${e}")
-  endif()
-endforeach()
-# The commit of the code that wrote it: a full hash (this is a checkout) or "unknown" (a tarball).
-string(JSON commit GET "${json}" provenance commit)
-string(LENGTH "${commit}" length)
-string(JSON dirty_type TYPE "${json}" provenance tree_dirty)
-if(NOT (commit MATCHES "^[0-9a-f]+$" AND length EQUAL 40) AND NOT commit STREQUAL "unknown"
-    OR NOT dirty_type MATCHES "^(BOOLEAN|NULL)$")
-  message(FATAL_ERROR "provenance: commit \"${commit}\", tree_dirty ${dirty_type}")
-endif()
+require_json_keys("${json}" "JSON"
+  KEYS frames_per_phase frame_period_ms hardware_threads skipped provenance)
+check_provenance("${json}")
 string(JSON ok GET "${json}" meshes 0 ok)
 if(NOT ok)
   message(FATAL_ERROR "the mug run failed: ${json}")
 endif()
-foreach(key name triangles create_call_ms setup_ms max_vertex_update_call_ms grab_latency_frames
-            calls_on)
-  string(JSON v ERROR_VARIABLE e GET "${json}" meshes 0 ${key})
-  if(e)
-    message(FATAL_ERROR "JSON mesh lacks ${key}: ${e}")
-  endif()
-endforeach()
+require_json_keys("${json}" "JSON mesh" PATH meshes 0
+  KEYS name triangles create_call_ms setup_ms max_vertex_update_call_ms grab_latency_frames
+       calls_on)
 string(JSON latency GET "${json}" meshes 0 grab_latency_frames)
 if(latency LESS 0)
   message(FATAL_ERROR "no grab latency: the grasp never showed")
 endif()
+# A phase's time added and the layer-off run's own times (the mesh and the outer-hand phases).
+set(phase_keys frames added_p50_ms added_p99_ms added_max_ms off_median_ms off_p99_ms off_max_ms)
 foreach(phase open grab held held_moving held_deforming)
-  foreach(key frames added_p50_ms added_p99_ms added_max_ms off_median_ms off_p99_ms off_max_ms
-              cpu_builds)
-    string(JSON v ERROR_VARIABLE e GET "${json}" meshes 0 phases ${phase} ${key})
-    if(e)
-      message(FATAL_ERROR "JSON phase ${phase} lacks ${key}: ${e}")
-    endif()
-  endforeach()
+  require_json_keys("${json}" "JSON phase ${phase}" PATH meshes 0 phases ${phase}
+    KEYS ${phase_keys} cpu_builds)
 endforeach()
 foreach(call xrWaitFrame xrBeginFrame xrSyncActions xrLocateHandJointsEXT xrEndFrame)
-  string(JSON v ERROR_VARIABLE e GET "${json}" meshes 0 calls_on ${call} p99_ms)
-  if(e)
-    message(FATAL_ERROR "JSON lacks the timing of ${call}: ${e}")
-  endif()
+  require_json_keys("${json}" "JSON's timing of ${call}" PATH meshes 0 calls_on ${call}
+    KEYS p99_ms)
 endforeach()
 # The outer-hand scenario with a small room: it runs, the outer hand moves the hand while it
 # touches (XrGraspHandOffsetSDFG), never with the outer hand switched off, and the JSON is complete.
@@ -74,26 +55,17 @@ string(JSON n LENGTH "${json}" meshes)
 if(NOT n EQUAL 0)
   message(FATAL_ERROR "--only outer measured ${n} objects")
 endif()
-foreach(key targets in_hand_box ok create_calls_total_ms create_call_max_ms setup_ms calls_on)
-  string(JSON v ERROR_VARIABLE e GET "${json}" outer ${key})
-  if(e)
-    message(FATAL_ERROR "JSON outer lacks ${key}: ${e}")
-  endif()
-endforeach()
+require_json_keys("${json}" "JSON outer" PATH outer
+  KEYS targets in_hand_box ok create_calls_total_ms create_call_max_ms setup_ms calls_on)
 string(JSON targets GET "${json}" outer targets)
 string(JSON ok GET "${json}" outer ok)
 if(NOT targets EQUAL 20 OR NOT ok)
   message(FATAL_ERROR "outer: ${targets} targets (expected 20), ok ${ok}:\n${json}")
 endif()
 foreach(phase near touching)
-  foreach(key frames added_p50_ms added_p99_ms added_max_ms off_median_ms off_p99_ms off_max_ms
-              hand_moved_frames outer_hand_off_added_p50_ms outer_hand_off_added_p99_ms
-              outer_hand_off_added_max_ms outer_hand_off_hand_moved_frames)
-    string(JSON v ERROR_VARIABLE e GET "${json}" outer phases ${phase} ${key})
-    if(e)
-      message(FATAL_ERROR "JSON outer phase ${phase} lacks ${key}: ${e}")
-    endif()
-  endforeach()
+  require_json_keys("${json}" "JSON outer phase ${phase}" PATH outer phases ${phase}
+    KEYS ${phase_keys} hand_moved_frames outer_hand_off_added_p50_ms outer_hand_off_added_p99_ms
+         outer_hand_off_added_max_ms outer_hand_off_hand_moved_frames)
 endforeach()
 string(JSON moved GET "${json}" outer phases touching hand_moved_frames)
 string(JSON movedOff GET "${json}" outer phases touching outer_hand_off_hand_moved_frames)

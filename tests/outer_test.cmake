@@ -4,6 +4,7 @@
 # a bad option is a usage error; the figures are the benchmark's business (and the quality test's,
 # outer_quality, which runs unpaced so they are the same every run).
 # Inputs: -DTOOL=<autograsp-outer> -DWORK=<scratch folder>
+include(${CMAKE_CURRENT_LIST_DIR}/json_checks.cmake)
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 execute_process(COMMAND ${TOOL} --quick --json ${WORK}/outer.json --per-frame
@@ -20,23 +21,14 @@ foreach(name ${names})
   endif()
 endforeach()
 file(READ ${WORK}/outer.json json)
-foreach(key tool provenance mode frame_period_ms draw_at_ms quick squeeze hardware_threads targets
-            trajectories)
-  string(JSON v ERROR_VARIABLE e GET "${json}" ${key})
-  if(e)
-    message(FATAL_ERROR "JSON lacks ${key}: ${e}")
-  endif()
-endforeach()
+require_json_keys("${json}" "JSON"
+  KEYS tool provenance mode frame_period_ms draw_at_ms quick squeeze hardware_threads targets
+       trajectories)
 string(JSON mode GET "${json}" mode)
 if(NOT mode STREQUAL "paced")
   message(FATAL_ERROR "mode ${mode}, expected paced")
 endif()
-# The commit of the code that wrote it: a full hash (this is a checkout) or "unknown" (a tarball).
-string(JSON commit GET "${json}" provenance commit)
-string(LENGTH "${commit}" length)
-if(NOT (commit MATCHES "^[0-9a-f]+$" AND length EQUAL 40) AND NOT commit STREQUAL "unknown")
-  message(FATAL_ERROR "provenance: commit \"${commit}\"")
-endif()
+check_provenance("${json}")
 string(JSON n LENGTH "${json}" trajectories)
 list(LENGTH names expected)
 if(NOT n EQUAL expected)
@@ -49,16 +41,12 @@ foreach(i RANGE ${last})
   if(NOT ok)
     message(FATAL_ERROR "${name} failed: ${json}")
   endif()
-  foreach(key frames penetration_mm capsule_penetration_max_mm tracked_depth_max_mm clear_frames
-              off_tracking_while_clear_max_mm off_tracking_while_clear_frames
-              keep_out_clear_frames off_tracking_while_clear_of_keep_out_max_mm still_frames
-              jitter_max_mm jitter_settled_max_mm pass_through outer_active_frames on_time_frames
-              cost_on_ms cost_off_ms meets_targets meets_targets_outside_keep_out)
-    string(JSON v ERROR_VARIABLE e GET "${json}" trajectories ${i} ${key})
-    if(e)
-      message(FATAL_ERROR "${name} lacks ${key}: ${e}")
-    endif()
-  endforeach()
+  require_json_keys("${json}" "${name}" PATH trajectories ${i}
+    KEYS frames penetration_mm capsule_penetration_max_mm tracked_depth_max_mm clear_frames
+         off_tracking_while_clear_max_mm off_tracking_while_clear_frames keep_out_clear_frames
+         off_tracking_while_clear_of_keep_out_max_mm still_frames jitter_max_mm
+         jitter_settled_max_mm pass_through outer_active_frames on_time_frames cost_on_ms
+         cost_off_ms meets_targets meets_targets_outside_keep_out)
   # Every frame of the outer-on run is in the per-frame record.
   string(JSON frames GET "${json}" trajectories ${i} frames)
   string(JSON recorded LENGTH "${json}" trajectories ${i} per_frame shown_clearance_mm)

@@ -3,6 +3,7 @@
 # succeeds and its JSON has every key docs/threading.md quotes; the figures are the benchmark's
 # business, not a test's.
 # Inputs: -DTOOL=<autograsp-threads> -DWORK=<scratch folder>
+include(${CMAKE_CURRENT_LIST_DIR}/json_checks.cmake)
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 execute_process(COMMAND ${TOOL} --quick --frames 20 --trials 1 --json ${WORK}/threads.json
@@ -14,13 +15,10 @@ if(NOT out MATCHES "locate p99, slow sync / normal sync")
   message(FATAL_ERROR "no ratio line in the output:\n${out}")
 endif()
 file(READ ${WORK}/threads.json json)
-foreach(key provenance frames delay_us hardware_threads locate_normal locate_slow_sync locate_p99_ratio
-            destroys)
-  string(JSON v ERROR_VARIABLE e GET "${json}" ${key})
-  if(e)
-    message(FATAL_ERROR "JSON lacks ${key}: ${e}")
-  endif()
-endforeach()
+require_json_keys("${json}" "JSON"
+  KEYS provenance frames delay_us hardware_threads locate_normal locate_slow_sync
+       locate_p99_ratio destroys)
+check_provenance("${json}")
 foreach(kind session_during_setup instance_during_setup session_during_build)
   string(JSON trials GET "${json}" destroys ${kind} trials)
   if(NOT trials EQUAL 1)

@@ -395,10 +395,7 @@ void setLayer(bool on) {
 // The placement of the object: centred in the default grab box of the right hand at `grip`.
 XrPosef objectPose(const XrPosef& grip, float yawRadians) {
   const sdfg::HandModel model = sdfg::HandModel::defaultAdult(sdfg::Hand::right);
-  const sdfg::Pose g{
-      glm::quat(grip.orientation.w, grip.orientation.x, grip.orientation.y, grip.orientation.z),
-      glm::vec3(grip.position.x, grip.position.y, grip.position.z)};
-  const sdfg::Pose worldFromWrist = g * sdfg::wristFromGrip(model).inverse();
+  const sdfg::Pose worldFromWrist = toPose(grip) * sdfg::wristFromGrip(model).inverse();
   const glm::vec3 c =
       worldFromWrist.transformPoint(sdfg::GridBox::referenceDefault().handFromBox.position);
   const glm::quat q = glm::angleAxis(yawRadians, glm::vec3(0, 1, 0));
@@ -410,7 +407,7 @@ RunResult run(const Object& object, bool layer, int phaseFrames) {
   setLayer(layer);
   App app(layer);
   if (!app.init(out.error)) return out;
-  const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+  const XrPosef grip = kGrip;
   const XrPosef pose0 = objectPose(grip, 0.0f);
   auto none = [] { return 0.0; };
   std::map<std::string, std::vector<double>> ignored;

@@ -20,12 +20,15 @@ Object meshObject(const std::string& name, const TriangleMesh& m) {
   return o;
 }
 
+Pose toPose(const XrPosef& p) {
+  return Pose{glm::quat(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z),
+              glm::vec3(p.position.x, p.position.y, p.position.z)};
+}
+
 OuterScene outerScene(int room) {
   OuterScene s;
   const HandModel model = HandModel::defaultAdult(Hand::right);
-  const Pose grip{glm::quat(s.grip.orientation.w, s.grip.orientation.x, s.grip.orientation.y,
-                            s.grip.orientation.z),
-                  glm::vec3(s.grip.position.x, s.grip.position.y, s.grip.position.z)};
+  const Pose grip = toPose(s.grip);
   JointPoses joints;
   JointRadii radii;
   placeJoints(model, curlsFromSqueeze(0.0f, MotionRange::unobstructed),

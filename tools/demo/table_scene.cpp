@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <thread>
 
@@ -27,8 +28,7 @@ using Clock = std::chrono::steady_clock;
 constexpr auto kFrame = std::chrono::microseconds(11111);
 constexpr auto kGraspBound = std::chrono::seconds(20);
 constexpr auto kSetupBound = std::chrono::seconds(20);
-constexpr uint64_t kSpace = 1;
-constexpr float kPi = 3.14159265358979f;  // the one space everything is placed in (the world)
+constexpr uint64_t kSpace = 1;  // the one space everything is placed in (the world)
 
 struct Object {
   uint64_t id = 0;
@@ -183,7 +183,8 @@ bool runTableScene(Renderer& renderer, const TableSceneOptions& options, SceneRe
       wristFromGrip(model).inverse();
   JointPoses open;
   model.pose(FingerCurls{}, open);
-  const glm::quat fingersToX = glm::angleAxis(-0.5f * kPi, glm::vec3(0, 1, 0));
+  const glm::quat fingersToX =
+      glm::angleAxis(-0.5f * std::numbers::pi_v<float>, glm::vec3(0, 1, 0));
   // The palm's surface 8 mm over the block's top, 1.5 cm toward the wrist from its middle.
   const glm::vec3 palm(0.085f, 0.05f + model.jointRadius(Joint::palm) + 0.008f, 0.0f);
   const Pose overBlock{fingersToX, palm - fingersToX * open[size_t(Joint::palm)].position};

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 
 #include <glm/geometric.hpp>
@@ -13,8 +14,6 @@
 
 namespace sdfg::outer_bench {
 namespace {
-
-constexpr float kPi = 3.14159265f;
 
 // Frames of linear motion and holds, 90 Hz.
 class Path {
@@ -174,7 +173,8 @@ PartClearance smallestPartClearance(const JointPoses& joints,
 std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale) {
   const glm::vec3 down(0, -1, 0), east(1, 0, 0);
   const glm::quat flat(1, 0, 0, 0);  // palm down, fingers toward -Z
-  const glm::quat palmEast = glm::angleAxis(0.5f * kPi, glm::vec3(0, 0, 1));  // palm toward +X
+  const glm::quat palmEast =
+      glm::angleAxis(0.5f * std::numbers::pi_v<float>, glm::vec3(0, 0, 1));  // palm toward +X
   auto secs = [&](double s) { return s * double(scale); };
   // Palm down 15 cm over the table; palm toward the mug's axis from -X, at the palm's height.
   const Pose overTable = at(flat, glm::vec3(0.0f, 0.15f, 0.09f));

@@ -40,11 +40,6 @@ bool listsLayer(const char* name) {
   return false;
 }
 
-// The layer's library file (tests/windows/CMakeLists.txt names the Windows DLL).
-#ifndef SDFG_LAYER_FILE_NAME
-#define SDFG_LAYER_FILE_NAME "libXrApiLayer_sdfg_autograsp.so"
-#endif
-
 // Which shared object a function pointer lives in.
 std::string objectOf(PFN_xrVoidFunction f) {
   Dl_info info{};

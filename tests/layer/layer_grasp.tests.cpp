@@ -17,39 +17,7 @@
 #include "test_scenes.h"
 #include "xr_harness.h"
 
-namespace {
-
 using namespace sdfg::test;
-
-GraspOutcome graspScene(const TestMesh& mesh, const XrPosef& objectPose, const XrPosef& grip,
-                        const char* hand = "right", uint32_t resolution = 0) {
-  XrEnv env;
-  env.handTracking = "absent";
-  env.script = gripLine(0, hand, grip) + squeezeLine(0, hand, 0.0f) + squeezeLine(4, hand, 0.0f) +
-               squeezeLine(6, hand, 1.0f);
-  applyEnv(env);
-  GraspOutcome out;
-  App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}});
-  REQUIRE(app.ok());
-  Ext ext(app);
-  const XrHandEXT xrHand = std::string(hand) == "left" ? XR_HAND_LEFT_EXT : XR_HAND_RIGHT_EXT;
-  XrHandTrackerEXT tracker = makeTracker(app, ext, xrHand);
-  if (resolution != 0) {
-    auto setOptions = app.fn<PFN_xrSetGraspOptionsSDFG>("xrSetGraspOptionsSDFG");
-    XrGraspOptionsSDFG o{XR_TYPE_GRASP_OPTIONS_SDFG};
-    o.resolution = resolution;
-    REQUIRE(setOptions(app.session, &o) == XR_SUCCESS);
-  }
-  makeTarget(app, ext, mesh, objectPose);
-  REQUIRE(framesUntilGrasping(app, ext, xrHand));
-  REQUIRE(locateJoints(app, tracker, out.joints) == XR_SUCCESS);
-  XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, xrHand};
-  REQUIRE(ext.state(app.session, &gi, &out.state) == XR_SUCCESS);
-  CHECK(validationLog().empty());
-  return out;
-}
-
-}  // namespace
 
 TEST_CASE("On a controller-only runtime the layer synthesizes 26 joints from grip and squeeze",
           "[layer][synthesis]") {

@@ -23,25 +23,10 @@ namespace {
 
 void graspSphereWith(const void* binding) {
   const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
-  XrEnv env;
-  env.handTracking = "absent";
-  env.script = gripLine(0, "right", grip) + squeezeLine(0, "right", 0.0f) +
-               squeezeLine(4, "right", 0.0f) + squeezeLine(6, "right", 1.0f);
-  applyEnv(env);
-  AppOptions options{{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}};
-  options.sessionNext = binding;
-  App app(options);
-  REQUIRE(app.ok());
-  Ext ext(app);
-  XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
   const XrVector3f centre = boxCentreInLocal(grip, /*right=*/true);
   const float radius = 0.04f;
-  makeTarget(app, ext, makeIcosphere(radius, 4), {{0, 0, 0, 1}, centre});
-  REQUIRE(framesUntilGrasping(app, ext, XR_HAND_RIGHT_EXT));
-  GraspOutcome out;
-  REQUIRE(locateJoints(app, tracker, out.joints) == XR_SUCCESS);
-  XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
-  REQUIRE(ext.state(app.session, &gi, &out.state) == XR_SUCCESS);
+  const GraspOutcome out =
+      graspScene(makeIcosphere(radius, 4), {{0, 0, 0, 1}, centre}, grip, "right", 0, binding);
   checkContacts(out, [&](const XrVector3f& p) { return length(sub(p, centre)) - radius; });
 }
 

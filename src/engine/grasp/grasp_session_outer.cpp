@@ -53,7 +53,7 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
       outer.engaged = false;
     }
     outer.view.active = false;
-    outer.view.changes = false;
+    outer.view.fallback = OuterNow{};
     return frame;
   };
   if (!settings_.outerHand || !frame.valid) return stop();
@@ -105,10 +105,7 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
   // since, else the hand where the last result showed it.
   OuterView& view = outer.view;
   view.active = true;
-  view.changes = false;
-  view.offset = Pose{};
-  view.capped.fill(false);
-  view.curl.fill(0.0f);
+  view.fallback = OuterNow{};
   if (fresh) {
     const OuterHandResult& r = latest->result;
     bool clear = !r.constrained;
@@ -128,10 +125,10 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
       clear = motion + settings_.outerOptions.margin < r.clearance;
     }
     if (!clear) {
-      view.offset = frame.worldFromWrist.inverse() * r.worldFromShownWrist;
-      view.capped = r.capped;
-      view.curl = r.curl;
-      view.changes = true;
+      view.fallback.offset = frame.worldFromWrist.inverse() * r.worldFromShownWrist;
+      view.fallback.capped = r.capped;
+      view.fallback.curl = r.curl;
+      view.fallback.changes = true;
     }
   }
 
@@ -144,7 +141,7 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
   job.time = double(frame.time) * 1e-9;
   job.model = view.model;
   job.options = settings_.outerOptions;
-  const Pose worldFromShown = frame.worldFromWrist * view.offset;
+  const Pose worldFromShown = frame.worldFromWrist * view.fallback.offset;
   if (held != 0) {
     if (auto at = index_.worldFromObject(held)) {
       job.attached = held;
@@ -157,7 +154,7 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
   view.ticket = outer.ticket;
   view.mailbox = worker_->outerMailbox(slot);
 
-  if (!view.changes) return frame;
+  if (!view.fallback.changes) return frame;
   HandFrame out = frame;
   out.worldFromWrist = worldFromShown;
   if (tracked) {

@@ -7,11 +7,11 @@
 namespace sdfg {
 
 OuterNow resolveOuter(const OuterView& view) {
-  OuterNow now;
-  if (!view.active) return now;
+  if (!view.active) return OuterNow{};
   if (view.mailbox != nullptr) {
     const std::shared_ptr<const GraspWorker::OuterDone> done = view.mailbox->latest.load();
     if (done != nullptr && done->ticket == view.ticket && done->status == Status::ok) {
+      OuterNow now;
       now.changes = done->result.constrained ||
                     std::any_of(done->result.capped.begin(), done->result.capped.end(),
                                 [](bool c) { return c; });
@@ -22,11 +22,7 @@ OuterNow resolveOuter(const OuterView& view) {
       return now;
     }
   }
-  now.changes = view.changes;
-  now.offset = view.offset;
-  now.capped = view.capped;
-  now.curl = view.curl;
-  return now;
+  return view.fallback;
 }
 
 void capFingers(const HandModel& model, const OuterNow& now, const Pose& baseFromWrist,

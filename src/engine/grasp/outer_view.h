@@ -20,27 +20,23 @@
 
 namespace sdfg {
 
+// The correction to draw: the shown wrist in the tracked wrist's frame, and per finger whether it
+// is shown at the model's pose at curl[f] instead of as given.
+struct OuterNow {
+  bool changes = false;  // false: draw the hand as given
+  Pose offset;
+  std::array<bool, kFingerCount> capped{};
+  std::array<float, kFingerCount> curl{};
+  bool onTime = false;  // from the update's own job (not the fallback)
+};
+
 struct OuterView {
   // The outer hand runs for this hand (a target is near it). False: the tracked hand, exactly.
   bool active = false;
   uint64_t ticket = 0;  // the job the update posted; its result replaces the fallback
   std::shared_ptr<const GraspWorker::OuterMailbox> mailbox;
-  // The fallback: the shown wrist in the tracked wrist's frame, and per finger whether it is shown
-  // at the model's pose at curl[f] instead of as given.
-  Pose offset;
-  std::array<bool, kFingerCount> capped{};
-  std::array<float, kFingerCount> curl{};
-  bool changes = false;  // the fallback differs from the tracked hand
+  OuterNow fallback;  // what the update decided from an earlier result (never onTime)
   HandModel model = HandModel::defaultAdult(Hand::right);  // whose curls capped fingers take
-};
-
-// The correction to draw now.
-struct OuterNow {
-  bool changes = false;  // false: draw the hand as given
-  Pose offset;           // the shown wrist in the tracked wrist's frame
-  std::array<bool, kFingerCount> capped{};
-  std::array<float, kFingerCount> curl{};
-  bool onTime = false;  // from the update's own job (not the fallback)
 };
 
 // The update's own result when the worker has published it, else the fallback.

@@ -128,10 +128,15 @@ std::string monadoManifest() {
   return path;
 }
 
+// Frames paced at 90 Hz, as an app's (the layer's worker gets the wall time between them), until
+// `done` holds or `seconds` pass.
 bool framesUntil(App& app, const std::function<void()>& each, const std::function<bool()>& done,
                  double seconds) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  auto next = std::chrono::steady_clock::now();
   while (std::chrono::steady_clock::now() < end) {
+    next += std::chrono::microseconds(11111);
+    std::this_thread::sleep_until(next);
     each();
     app.frame();
     if (done()) return true;
@@ -207,15 +212,14 @@ void grabAndRelease(Graphics graphics) {
   const float radius = 0.04f;
   makeTarget(app, ext, makeIcosphere(radius, 4), {{0, 0, 0, 1}, centre});
 
-  // Close over about a second, then hold until the grasp has settled.
-  const auto start = std::chrono::steady_clock::now();
+  // Close over 90 frames (a second at 90 Hz), then hold until the grasp has settled.
+  int closed = 0;
   XrGraspStateSDFG state{XR_TYPE_GRASP_STATE_SDFG};
   XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
   const bool held = framesUntil(
       app,
       [&] {
-        const std::chrono::duration<float> t = std::chrono::steady_clock::now() - start;
-        closing = std::min(1.0f, t.count());
+        closing = std::min(1.0f, float(++closed) / 90.0f);
         frame();
       },
       [&] {

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Builds the Khronos OpenXR CTS (conformance_cli, conformance_test) from the archive in
-# ../shared/cts into <out-dir>, once per archive: the build is keyed by the archive's SHA-256,
-# so a second run reuses it. The source is extracted into the build tree and fixed there, never
-# copied into the repository (../shared/cts/README.md lists the two fixes):
+# ../shared/cts into <out-dir>, once per archive and version of this script: the build is keyed
+# by both SHA-256s (third_party_unpack.sh), so a second run reuses it and a changed fix rebuilds.
+# The source is extracted into the build tree and fixed there, never copied into the repository
+# (../shared/cts/README.md lists the two fixes):
 #   - the archive holds git-lfs pointers instead of binary assets; CMake's FATAL_ERROR on them
 #     becomes a warning (only interactive and rendering cases read those assets);
 #   - the Vulkan graphics plugin decodes brdf_lut.png from the working directory at start: a
@@ -14,6 +15,7 @@ archive=$1
 out=$2
 jobs=${3:-2}
 name=cts
+recipe="${BASH_SOURCE[0]}"
 # Sets root, stamp, src and start, or exits 77 (no archive) or 0 (already built).
 source "$(dirname "${BASH_SOURCE[0]}")/../third_party_unpack.sh"
 sed -i 's/FATAL_ERROR\(.*\)$/WARNING\1/' "$src/src/conformance/conformance_test/CMakeLists.txt"

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Builds Monado (headless, in-process: no service, no IPC, null compositor, drivers simulated and
 # remote, no window system, USB, OpenCV or SDL) from the archive in ../shared/monado into
-# <out-dir>, once per archive: keyed by the archive's SHA-256, so a second run reuses it. The
-# source is extracted into the build tree and fixed there, never copied into the repository
+# <out-dir>, once per archive and version of this script: keyed by both SHA-256s
+# (third_party_unpack.sh), so a second run reuses it and a changed fix rebuilds. The source is
+# extracted into the build tree and fixed there, never copied into the repository
 # (../shared/monado/README.md):
 #   - src/xrt/targets/openxr/CMakeLists.txt links comp_main even with the main compositor off:
 #     it is dropped from that list (the null compositor is linked through target_lists);
@@ -15,6 +16,7 @@ archive=$1
 out=$2
 jobs=${3:-2}
 name=monado
+recipe="${BASH_SOURCE[0]}"
 # Sets root, stamp, src and start, or exits 77 (no archive) or 0 (already built).
 source "$(dirname "${BASH_SOURCE[0]}")/../third_party_unpack.sh"
 target_cmake="$src/src/xrt/targets/openxr/CMakeLists.txt"

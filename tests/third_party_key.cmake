@@ -1,7 +1,8 @@
-# The folder a third-party build from ../shared lives in, as tests/third_party_unpack.sh names it:
-# the first 16 hex of the archive's SHA-256, '-', the first 8 of the build script's, so a changed
-# fix in the script makes a new build instead of reusing one made without it. "absent" without
-# the archive (the build and its tests then report themselves skipped).
+# The name of the folder a third-party build from ../shared lives in (given to its build script
+# and to the tests that read its built.stamp): the first 16 hex of the archive's SHA-256, '-', the
+# first 8 of the build script's, so a changed fix in the script makes a new build instead of
+# reusing one made without it. "absent" without the archive (the build and its tests then report
+# themselves skipped).
 function(sdfg_third_party_key archive recipe out_var)
   if(EXISTS "${archive}")
     file(SHA256 "${archive}" archive_hash)

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the Khronos OpenXR CTS (conformance_cli, conformance_test) from the archive in
-# ../shared/cts into <out-dir>, once per archive and version of this script: the build is keyed
-# by both SHA-256s (third_party_unpack.sh), so a second run reuses it and a changed fix rebuilds.
+# ../shared/cts into <build-dir>, once: CMake names that folder by the archive's and this script's
+# SHA-256 (tests/third_party_key.cmake), so a second run reuses it and a changed fix rebuilds.
 # The source is extracted into the build tree and fixed there, never copied into the repository
 # (../shared/cts/README.md lists the first two fixes):
 #   - the archive holds git-lfs pointers instead of binary assets; CMake's FATAL_ERROR on them
@@ -14,14 +14,13 @@
 #     crashed in std::_Rb_tree_insert_and_rebalance (1 run in 30 at d2405d2 with the layer idle,
 #     which was in none of the core's stacks; CI counted it a regression). The map gets a mutex.
 # Exit 0: built (or cached); 77: no archive (the caller reports SKIPPED); other: build failed.
-# Usage: build_cts.sh <archive.tar.xz> <out-dir> [jobs]
+# Usage: build_cts.sh <archive.tar.xz> <build-dir> [jobs]
 set -euo pipefail
 archive=$1
-out=$2
+root=$2
 jobs=${3:-2}
 name=cts
-recipe="${BASH_SOURCE[0]}"
-# Sets root, stamp, src and start, or exits 77 (no archive) or 0 (already built).
+# Sets stamp, src and start, or exits 77 (no archive) or 0 (already built).
 source "$(dirname "${BASH_SOURCE[0]}")/../third_party_unpack.sh"
 sed -i 's/FATAL_ERROR\(.*\)$/WARNING\1/' "$src/src/conformance/conformance_test/CMakeLists.txt"
 grep -q 'WARNING' "$src/src/conformance/conformance_test/CMakeLists.txt"
@@ -51,10 +50,7 @@ for pattern, repl in edits:
     text, n = re.subn(pattern, repl, text)
     if n != 1:
         sys.exit("build_cts: %s matched %d times in %s" % (pattern, n, path))
-whole = whole[:start] + text + whole[end:]
-if "#include <mutex>" not in whole:
-    whole = whole.replace("#include <map>", "#include <map>\n#include <mutex>", 1)
-open(path, "w").write(whole)
+open(path, "w").write(whole[:start] + text + whole[end:])
 PY
 cmake -S "$src" -B "$root/build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DPRESENTATION_BACKEND=xlib -DBUILD_TESTS=OFF >"$root/configure.log" 2>&1 ||

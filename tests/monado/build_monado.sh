@@ -1,23 +1,22 @@
 #!/usr/bin/env bash
 # Builds Monado (headless, in-process: no service, no IPC, null compositor, drivers simulated and
 # remote, no window system, USB, OpenCV or SDL) from the archive in ../shared/monado into
-# <out-dir>, once per archive and version of this script: keyed by both SHA-256s
-# (third_party_unpack.sh), so a second run reuses it and a changed fix rebuilds. The source is
+# <build-dir>, once: CMake names that folder by the archive's and this script's SHA-256
+# (tests/third_party_key.cmake), so a second run reuses it and a changed fix rebuilds. The source is
 # extracted into the build tree and fixed there, never copied into the repository
 # (../shared/monado/README.md):
 #   - src/xrt/targets/openxr/CMakeLists.txt links comp_main even with the main compositor off:
 #     it is dropped from that list (the null compositor is linked through target_lists);
 #   - the remote driver links aux_vive: XRT_MODULE_AUX_VIVE stays on.
-# Exit 0: built (or cached), the runtime manifest's path in <out-dir>/<hash>/built.stamp;
+# Exit 0: built (or cached), the runtime manifest's path in <build-dir>/built.stamp;
 # 77: no archive (the caller reports SKIPPED); other: build failed.
-# Usage: build_monado.sh <archive.tar.xz> <out-dir> [jobs]
+# Usage: build_monado.sh <archive.tar.xz> <build-dir> [jobs]
 set -euo pipefail
 archive=$1
-out=$2
+root=$2
 jobs=${3:-2}
 name=monado
-recipe="${BASH_SOURCE[0]}"
-# Sets root, stamp, src and start, or exits 77 (no archive) or 0 (already built).
+# Sets stamp, src and start, or exits 77 (no archive) or 0 (already built).
 source "$(dirname "${BASH_SOURCE[0]}")/../third_party_unpack.sh"
 target_cmake="$src/src/xrt/targets/openxr/CMakeLists.txt"
 sed -i '/^\t\t\tcomp_main$/d' "$target_cmake"

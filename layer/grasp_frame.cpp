@@ -178,7 +178,7 @@ bool finishGather(SessionState& s, const Plan& p, const Gathered* g) {
 // What the update found, logged after the unlock.
 struct UpdateReport {
   std::array<Status, 2> status{Status::ok, Status::ok};
-  std::vector<std::pair<uint64_t, MeshOrientation>> orientations;
+  std::vector<std::pair<uint64_t, MeshSetupReport>> setups;
   std::vector<std::pair<uint64_t, std::string>> refusedUpdates;
   std::vector<std::pair<uint64_t, std::string>> setupFailures;
 };
@@ -217,7 +217,7 @@ void updateHands(SessionState& s, const Gathered& g, UpdateReport& report) {
     advanceHandOffset(offset, s.grasp->grasp(hand), s.predictedTime, s.offsets.blendTime);
   }
   publishShownHands(s);
-  report.orientations = s.grasp->takeSetupOrientations();
+  report.setups = s.grasp->takeSetupReports();
   report.refusedUpdates = s.grasp->takeRefusedUpdates();
   report.setupFailures = s.grasp->takeSetupFailures();
 }
@@ -233,15 +233,21 @@ void logReport(const InstanceState& inst, const UpdateReport& report, const char
       SDFG_LOG_WARN(cmd, "grasp solve failed (%s); the hand stays open until it is released",
                     toString(st));
   }
-  // Set-ups run on the session's worker: one line per target on how its mesh was wound, and one
-  // per target whose mesh it could not take.
-  for (const auto& [id, o] : report.orientations) {
+  // Set-ups run on the session's worker: one line per target on what its mesh was found to be
+  // (split vertices welded, repeated triangles dropped, winding, closed parts), and one per
+  // target whose mesh it could not take.
+  for (const auto& [id, found] : report.setups) {
+    const MeshOrientation& o = found.orientation;
+    const std::string weld = found.weld.describe();
     if (o.flipped > 0)
-      SDFG_LOG_WARN(cmd, "target %#llx: mesh wound %s; %u triangles flipped to face outward",
-                    static_cast<unsigned long long>(id), o.describe(), o.flipped);
+      SDFG_LOG_WARN(cmd,
+                    "target %#llx: %s; mesh wound %s, %u triangles flipped to face outward (%u "
+                    "parts, %u closed)",
+                    static_cast<unsigned long long>(id), weld.c_str(), o.describe(), o.flipped,
+                    o.components, o.closedComponents);
     else
-      SDFG_LOG_INFO(cmd, "target %#llx: mesh wound %s (%u parts, %u closed)",
-                    static_cast<unsigned long long>(id), o.describe(), o.components,
+      SDFG_LOG_INFO(cmd, "target %#llx: %s; mesh wound %s (%u parts, %u closed)",
+                    static_cast<unsigned long long>(id), weld.c_str(), o.describe(), o.components,
                     o.closedComponents);
   }
   for (const auto& [id, why] : report.refusedUpdates)

@@ -105,9 +105,9 @@ std::vector<std::pair<uint64_t, std::string>> GraspSession::takeRefusedUpdates()
   return worker_->takeRefusedUpdates();
 }
 
-std::vector<std::pair<uint64_t, MeshOrientation>> GraspSession::takeSetupOrientations() {
+std::vector<std::pair<uint64_t, MeshSetupReport>> GraspSession::takeSetupReports() {
   refreshSetups();
-  return std::exchange(setupOrientations_, {});
+  return std::exchange(setupReports_, {});
 }
 
 bool GraspSession::waitWorkerIdle(std::chrono::milliseconds timeout) const {
@@ -126,10 +126,10 @@ void GraspSession::refreshSetups() {
       // Bounds set by updateTargetVertices meanwhile are newer than the set-up's.
       if (t.version == 0) t.bounds = info.bounds;
       t.setup = TargetSetup::ready;
-      // The GPU's copy takes the triangles as the set-up turned them outward.
+      // The GPU's copy takes the triangles as the set-up welded them and turned them outward.
       if (t.deviceCopy != nullptr && info.orientedIndices != nullptr)
         t.deviceCopy->indices = *info.orientedIndices;
-      setupOrientations_.emplace_back(id, info.orientation);
+      setupReports_.emplace_back(id, info.found);
       reindex(id, t);
     } else if (info.setup == TargetSetup::failed) {
       t.setup = TargetSetup::failed;

@@ -174,9 +174,10 @@ class GraspSession {
   Status addTarget(uint64_t id, TriangleMesh mesh);
   // ready for device targets at once.
   TargetSetup targetSetup(uint64_t id) const;
-  // What each set-up finished since the last call found of its mesh's winding (the worker turns
-  // every part outward), for the owner to report once.
-  std::vector<std::pair<uint64_t, MeshOrientation>> takeSetupOrientations();
+  // What each set-up finished since the last call found of its mesh: split vertices welded,
+  // repeated triangles dropped, the winding (the worker turns every part outward); for the owner
+  // to report once.
+  std::vector<std::pair<uint64_t, MeshSetupReport>> takeSetupReports();
   // Targets whose set-up failed since the last call, with the reason (each reported once).
   std::vector<std::pair<uint64_t, std::string>> takeSetupFailures();
   // Targets whose new vertices the worker refused since the last call (a triangle collapsed to
@@ -388,7 +389,7 @@ class GraspSession {
   GraspSettings settings_;
   std::map<uint64_t, Target> targets_;
   SceneIndex index_;
-  std::vector<std::pair<uint64_t, MeshOrientation>> setupOrientations_;
+  std::vector<std::pair<uint64_t, MeshSetupReport>> setupReports_;
   std::vector<uint64_t> pendingSetups_;  // ids whose set-up may still be running (refreshSetups)
   size_t failedSetups_ = 0;
   std::array<HandState, 2> hands_;

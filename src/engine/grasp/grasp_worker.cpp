@@ -131,7 +131,7 @@ GraspWorker::TargetInfo GraspWorker::targetInfo(uint64_t id) const {
   std::lock_guard lock(mutex_);
   auto it = targets_.find(id);
   if (it == targets_.end()) return {};
-  return {it->second->setup, it->second->bounds, it->second->error, it->second->orientation,
+  return {it->second->setup, it->second->bounds, it->second->error, it->second->found,
           it->second->orientedIndices};
 }
 
@@ -394,7 +394,7 @@ void GraspWorker::runSetup(std::unique_lock<std::mutex>& lock, uint64_t id,
   std::shared_ptr<MeshDistance> distance;
   std::string error;
   Aabb bounds;
-  MeshOrientation orientation;
+  MeshSetupReport found;
   std::shared_ptr<const std::vector<uint32_t>> orientedIndices;
   // Every step looks at the target's stop flag (removed, replaced, or the worker destroyed).
   const WorkLimit limit{WorkLimit::Clock::time_point::max(), &target->stop};
@@ -406,14 +406,29 @@ void GraspWorker::runSetup(std::unique_lock<std::mutex>& lock, uint64_t id,
       error = refused->message;
     } else {
       bounds = computeBounds(mesh.positions);
+      // Game meshes split their vertices at seams and hard edges: the winding repair below and
+      // every sign need the topology of the surface, not of the indices. The app's positions stay
+      // as they are (its vertex updates apply one for one); only this copy of the indices
+      // changes. A weld that would leave a sliver of zero area is not taken.
+      std::vector<uint32_t> given = mesh.indices;
+      found.weld = weldByPosition(mesh.positions, mesh.indices, limit);
+      if (found.weld.changed() && !found.weld.stopped &&
+          validateMesh(mesh.positions, mesh.indices, limit)) {
+        mesh.indices = std::move(given);
+        const uint32_t used = found.weld.vertices;
+        found.weld = WeldReport{};
+        found.weld.vertices = found.weld.weldedVertices = used;
+      }
+      given = {};
       // Meshes come wound either way, or both: the SDF's sign needs outward triangles. An open
       // part's winding-number vote costs O(samples x triangles), so it runs here, not in the
       // app's create call.
-      orientation = orientOutward(mesh.positions, mesh.indices, limit);
-      if (orientation.stopped) {
+      if (!found.weld.stopped)
+        found.orientation = orientOutward(mesh.positions, mesh.indices, limit);
+      if (found.weld.stopped || found.orientation.stopped) {
         error = "the set-up was stopped";
       } else {
-        if (orientation.flipped > 0)
+        if (found.orientation.flipped > 0 || found.weld.changed())
           orientedIndices = std::make_shared<const std::vector<uint32_t>>(mesh.indices);
         auto made = MeshDistance::create(mesh, limit);
         if (made)
@@ -448,7 +463,7 @@ void GraspWorker::runSetup(std::unique_lock<std::mutex>& lock, uint64_t id,
   if (distance != nullptr) {
     target->distance = std::move(distance);
     target->bounds = bounds;
-    target->orientation = orientation;
+    target->found = found;
     target->orientedIndices = std::move(orientedIndices);
     keepSpares(*target, spares);
     target->setup = TargetSetup::ready;

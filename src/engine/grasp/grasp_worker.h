@@ -51,12 +51,20 @@
 #include "mesh/mesh.h"
 #include "mesh/mesh_distance.h"
 #include "mesh/mesh_orientation.h"
+#include "mesh/mesh_weld.h"
 #include "scene/analytic_shape.h"
 #include "scene/scene.h"
 #include "sdf/sdf_backend.h"
 #include "sdf/sdf_grid.h"
 
 namespace sdfg {
+
+// What a target's set-up found of its mesh, for the owner to tell the app once: the vertices it
+// welded and triangles it dropped (weldByPosition), then the winding it repaired (orientOutward).
+struct MeshSetupReport {
+  WeldReport weld{};
+  MeshOrientation orientation{};
+};
 
 class SceneExactSource;  // grasp/scene_exact_source.h
 
@@ -75,9 +83,10 @@ class GraspWorker {
     TargetSetup setup = TargetSetup::unknown;
     Aabb bounds;        // of the positions last set up or refit (valid once ready)
     std::string error;  // why the set-up failed
-    // What the set-up found of the mesh's winding (orientOutward, valid once ready), and the
-    // indices it turned outward when it flipped any (null: the app's were outward already).
-    MeshOrientation orientation{};
+    // What the set-up found of the mesh (valid once ready): its split vertices and repeated
+    // triangles (weldByPosition) and its winding (orientOutward); and the indices as it welded
+    // and turned them outward when either changed anything (null: the app's were kept).
+    MeshSetupReport found{};
     std::shared_ptr<const std::vector<uint32_t>> orientedIndices;
   };
 
@@ -257,7 +266,7 @@ class GraspWorker {
     TargetSetup setup = TargetSetup::pending;
     Aabb bounds;
     std::string error;
-    MeshOrientation orientation{};
+    MeshSetupReport found{};
     std::shared_ptr<const std::vector<uint32_t>> orientedIndices;
     bool lastUpdateRefused = false;  // worker thread only: reports a run of refusals once
   };

@@ -14,6 +14,7 @@
 #include <glm/matrix.hpp>
 
 #include "base/polled_sort.h"
+#include "mesh/mesh_weld.h"
 #include "mesh/triangle_bvh.h"
 
 namespace sdfg {
@@ -135,7 +136,9 @@ bool MeshDistance::Impl::buildTopology(const WorkLimit& limit) {
     ++edgeCount;
     i = j;
   }
-  pseudoNormalSign = closed && oriented;
+  // Closed parts that overlap (pieces of a model pushed into each other) read as outside in their
+  // overlap by pseudo-normals; the winding number counts both.
+  pseudoNormalSign = closed && oriented && !partsOverlap(mesh.positions, mesh.indices);
   return true;
 }
 
@@ -377,6 +380,13 @@ Result<std::unique_ptr<MeshDistance>> MeshDistance::create(const TriangleMesh& m
   const Error stopped = makeError(Status::timed_out, "mesh distance: the set-up was stopped");
   auto impl = std::make_unique<Impl>();
   impl->mesh = mesh;
+  // The topology (shared edges, pseudo-normals, closedness) as the surface has it: split
+  // vertices welded, repeated triangles dropped (mesh_weld.h). A weld that would leave a
+  // triangle of zero area (a sliver thinner than the tolerance) is not taken.
+  const WeldReport weld = weldByPosition(impl->mesh.positions, impl->mesh.indices, limit);
+  if (weld.stopped) return stopped;
+  if (weld.changed() && validateMesh(impl->mesh.positions, impl->mesh.indices, limit))
+    impl->mesh.indices = mesh.indices;
   if (!impl->bvh.build(impl->mesh.positions, impl->mesh.indices, 4, limit)) return stopped;
   if (!impl->buildTopology(limit) || !impl->computeNormals(limit)) return stopped;
   if (!impl->pseudoNormalSign) {

@@ -4,7 +4,9 @@
 // pseudo-normals) and refit, not rebuilt, when the vertices move. The distance is exact (the
 // closest point on the closest triangle). The sign comes from the angle-weighted pseudo-normal of
 // the closest feature (face, edge or vertex; Baerentzen & Aanaes 2005) on closed meshes, and from
-// the generalized winding number (Jacobson et al. 2013) where the mesh is open.
+// the generalized winding number (Jacobson et al. 2013) where the mesh is open or its closed parts
+// overlap. The topology is the surface's, not the indices': split vertices are welded and repeated
+// triangles dropped first (mesh_weld.h), so a triangle soup is signed like the indexed mesh.
 #pragma once
 
 #include <cstdint>
@@ -46,8 +48,11 @@ class MeshDistance {
   Status updatePositions(std::span<const glm::vec3> positions,
                          const WorkLimit& limit = WorkLimit::none());
 
+  // The mesh as welded (mesh_weld.h): the given positions, indices that share the vertices the
+  // given ones split, without repeated triangles. Triangle ids of the queries index this mesh.
   const TriangleMesh& mesh() const;
-  // True when every edge has exactly two triangles (no boundary, no non-manifold edge).
+  // True when every edge of the welded mesh has exactly two triangles (no boundary, no
+  // non-manifold edge).
   bool isClosed() const;
 
   ClosestPoint closest(const glm::vec3& p) const;

@@ -29,7 +29,9 @@ Status GrabBoxSdf::setMesh(const TriangleMesh& mesh) {
   auto distance = MeshDistance::create(mesh);
   if (!distance) return distance.error().code;
   if (gpu_) {
-    const Status s = gpu_->setMesh(mesh);
+    // The welded mesh (MeshDistance::mesh()): the device signs a closed one by pseudo-normals,
+    // which need the topology the app's split vertices hide (mesh/mesh_weld.h).
+    const Status s = gpu_->setMesh((*distance)->mesh());
     if (s == Status::invalid_argument) return s;
     if (s != Status::ok) fallBack();
   }

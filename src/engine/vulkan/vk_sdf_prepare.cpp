@@ -4,6 +4,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "mesh/mesh_weld.h"
 #include "vulkan/vk_sdf_builder_detail.h"
 
 namespace sdfg::vk_sdf_detail {
@@ -20,8 +21,10 @@ uint32_t spreadBits(uint32_t v) {
 }
 
 // Pseudo-normals of every triangle's edges and corners when the mesh is closed (every edge has
-// two triangles) and consistently oriented (they traverse it in opposite directions), in the
-// mesh's triangle order; nothing otherwise (those meshes are signed by the winding number).
+// two triangles), consistently oriented (they traverse it in opposite directions) and its closed
+// parts do not overlap, in the mesh's triangle order; nothing otherwise (those meshes are signed
+// by the winding number, as MeshDistance signs them). The caller gives the mesh welded
+// (mesh/mesh_weld.h) where its vertices may be split: split vertices read as open edges here.
 std::optional<std::vector<L::TrianglePseudoNormals>> pseudoNormals(const TriangleMesh& mesh) {
   const size_t triangles = mesh.triangleCount();
   struct HalfEdge {
@@ -62,6 +65,7 @@ std::optional<std::vector<L::TrianglePseudoNormals>> pseudoNormals(const Triangl
     out[s0 / 3].edge[s0 % 3] = n;
     out[s1 / 3].edge[s1 % 3] = n;
   }
+  if (partsOverlap(mesh.positions, mesh.indices)) return std::nullopt;
   for (size_t t = 0; t < triangles; ++t) {
     for (int k = 0; k < 3; ++k) {
       out[t].corner[k] = glm::vec4(glm::vec3(vertex[mesh.indices[3 * t + k]]), 0.0f);

@@ -1,15 +1,22 @@
 // autograsp-frame-cost: what the layer costs an app per frame.
 //
-// A minimal OpenXR app (headless session, so every grab-box SDF is built on the CPU, as on an
-// OpenGL app or a machine without a usable GPU) runs through the real Khronos loader and the mock
-// runtime (controllers only: the layer synthesizes the hands), paced at 90 Hz like a compositor
-// would. For each object it runs the same script twice in one process: with the layer off (its
-// disable variable set) and on (enabled explicitly from the build tree, with its defaults). It
-// times every OpenXR call the app makes per frame with steady_clock: xrWaitFrame, xrBeginFrame,
-// xrSyncActions, xrLocateHandJointsEXT (both hands), xrGetGraspStateSDFG, the target's
-// placement or vertex update when the phase has one, and xrEndFrame. The time added per frame is
-// the on-run's frame total minus the off-run's median frame total of the same phase (the off run
-// makes no extension calls: their whole cost counts as added).
+// A minimal OpenXR app runs through the real Khronos loader and the mock runtime (controllers
+// only: the layer synthesizes the hands), paced at 90 Hz like a compositor would. By default its
+// session is headless, so every grab-box SDF is built on the CPU, as on an OpenGL app or a
+// machine without a usable GPU. With --session vulkan it is a Vulkan session
+// (XR_KHR_vulkan_enable2) on the physical device the runtime names, whose SDFs the layer builds
+// on that device; with --target buffer as well, the object lives in the app's Vulkan storage
+// buffers (XrGraspTargetVulkanBuffersSDFG), which the deforming phase rewrites on the binding's
+// queue every frame as a skinning pass would (vulkan_app.h).
+//
+// For each object it runs the same script twice in one process: with the layer off (its disable
+// variable set) and on (enabled explicitly from the build tree or --layer-dir, with its defaults
+// but `gpu`, which --gpu sets on a Vulkan session). It times every OpenXR call the app makes per
+// frame with steady_clock: xrWaitFrame, xrBeginFrame, xrSyncActions, xrLocateHandJointsEXT (both
+// hands), xrGetGraspStateSDFG, the target's placement or vertex update when the phase has one,
+// and xrEndFrame. The time added per frame is the on-run's frame total minus the off-run's median
+// frame total of the same phase (the off run makes no extension calls: their whole cost counts
+// as added).
 //
 // Phases: open (squeeze 0), grab (from the squeeze crossing the threshold until the grasp is
 // shown; its length is the grab latency in frames), held (still), held moving (30 degrees over 60
@@ -21,7 +28,14 @@
 // hand in the touching phase. --room N registers N targets in all, the rest spread over a room
 // (issue 26's scale: 1000 targets, the hand's 5 among them).
 //
-// Options: kUsage below (--help prints it).
+// Options: kUsage below (--help prints it). The layer and the mock runtime are found through the
+// build tree's paths by default; --layer-dir and --runtime-json point at a relocated copy
+// (package-for-device.sh makes one for another machine).
+//
+// First: it defines XR_USE_GRAPHICS_API_VULKAN before the extension's header, which declares
+// XrGraspTargetVulkanBuffersSDFG only then.
+#include "vulkan_app.h"
+
 #include <openxr/openxr.h>
 
 #include <openxr/XR_SDFG_auto_grasp.h>
@@ -66,17 +80,32 @@ constexpr auto kFramePeriod = std::chrono::nanoseconds(11'111'111);  // 90 Hz
 
 const char* const kUsage =
     "usage: autograsp-frame-cost [--frames N] [--embedded-only] [--only NAME]... [--room N]\n"
-    "                            [--json FILE]\n"
+    "                            [--session headless|vulkan] [--target arrays|buffer]\n"
+    "                            [--gpu auto|on|off] [--layer-dir DIR] [--runtime-json FILE]\n"
+    "                            [--meshes DIR] [--json FILE]\n"
     "  --frames N       frames per phase (default 60, at least 2; the smoke test uses a few)\n"
-    "  --embedded-only  skip ../shared/meshes (the bunny and the armadillos)\n"
+    "  --embedded-only  skip the research meshes (the bunny and the armadillos)\n"
+    "  --meshes DIR     where the research meshes are (default: ../shared/meshes of the source\n"
+    "                   tree the tool was built from)\n"
     "  --only NAME      measure only the object called NAME (repeatable); \"outer\" names the\n"
     "                   outer-hand scenario\n"
     "  --room N         the outer-hand scenario registers N targets (default 5, at least 5): 5 in\n"
     "                   the hand's box, the rest spread over a 10 x 10 m room\n"
+    "  --session KIND   headless (default: every SDF built on the CPU) or vulkan (a Vulkan\n"
+    "                   session on the first device the runtime names; VK_DRIVER_FILES picks\n"
+    "                   the driver)\n"
+    "  --target KIND    the objects as arrays (default) or, with --session vulkan, in the app's\n"
+    "                   Vulkan storage buffers (XrGraspTargetVulkanBuffersSDFG); the outer-hand\n"
+    "                   scenario always uses arrays\n"
+    "  --gpu MODE       the layer's gpu setting for --session vulkan (default on: the device\n"
+    "                   builds every target, also on a CPU device such as lavapipe)\n"
+    "  --layer-dir DIR  folder of the layer's explicit manifest (default: the build tree's)\n"
+    "  --runtime-json FILE  the mock runtime's manifest (default: $XR_RUNTIME_JSON, else the\n"
+    "                   build tree's)\n"
     "  --json FILE      write the results as JSON (without it nothing is written)\n"
     "  --help           this text\n"
     "exit codes: 0 every object measured; 1 an object failed or the JSON could not be written;\n"
-    "2 bad option\n";
+    "2 bad option, or the runtime's or the layer's manifest or library is missing\n";
 
 double ms(Clock::duration d) {
   return std::chrono::duration<double, std::milli>(d).count();
@@ -114,9 +143,14 @@ std::string squeezeLine(uint64_t frame, float value) {
   return buf;
 }
 
+enum class SessionKind { headless, vulkan };
+enum class TargetKind { arrays, buffer };
+
 class App {
  public:
-  explicit App(bool layer) : layer_(layer) {}
+  App(bool layer, SessionKind session) : layer_(layer), sessionKind_(session) {}
+  // The session and the instance first: the layer frees what it made on the app's device in
+  // xrDestroySession; then vk_'s destructor frees the buffers and the device.
   ~App() {
     if (session_ != XR_NULL_HANDLE) {
       if (running_) {
@@ -129,7 +163,9 @@ class App {
   }
 
   bool init(std::string& error) {
-    std::vector<const char*> ext{XR_MND_HEADLESS_EXTENSION_NAME};
+    const bool vulkan = sessionKind_ == SessionKind::vulkan;
+    std::vector<const char*> ext{vulkan ? XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME
+                                        : XR_MND_HEADLESS_EXTENSION_NAME};
     if (layer_) {
       ext.push_back(XR_SDFG_AUTO_GRASP_EXTENSION_NAME);
       ext.push_back(XR_EXT_HAND_TRACKING_EXTENSION_NAME);
@@ -149,6 +185,12 @@ class App {
     if (xrGetSystem(instance_, &sgi, &system) != XR_SUCCESS) return fail(error, "xrGetSystem");
     XrSessionCreateInfo sci{XR_TYPE_SESSION_CREATE_INFO};
     sci.systemId = system;
+    XrGraphicsBindingVulkan2KHR binding{XR_TYPE_GRAPHICS_BINDING_VULKAN2_KHR};
+    if (vulkan) {
+      if (!vk_.create(instance_, system, error)) return false;
+      binding = vk_.binding();
+      sci.next = &binding;
+    }
     if (xrCreateSession(instance_, &sci, &session_) != XR_SUCCESS)
       return fail(error, "xrCreateSession");
     XrReferenceSpaceCreateInfo rs{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};
@@ -233,6 +275,13 @@ class App {
   // as part of the frame). Returns the app's time in OpenXR calls (ms); fills calls[name].
   template <class F>
   double frame(std::map<std::string, std::vector<double>>& calls, F before) {
+    return frame(calls, before, [] { return 0.0; });
+  }
+  // The same, and `inFrame` (its returned time counted too) runs after xrBeginFrame, before
+  // xrSyncActions: where an app submits its skinning on the binding's queue, which is the app's
+  // between the frame calls.
+  template <class F, class G>
+  double frame(std::map<std::string, std::vector<double>>& calls, F before, G inFrame) {
     const auto frameStart = Clock::now();
     double total = 0;
     auto timed = [&](const char* name, auto&& call) {
@@ -249,6 +298,7 @@ class App {
     timed("xrWaitFrame", [&] { xrWaitFrame(session_, &wi, &fs); });
     XrFrameBeginInfo bi{XR_TYPE_FRAME_BEGIN_INFO};
     timed("xrBeginFrame", [&] { xrBeginFrame(session_, &bi); });
+    total += inFrame();
     XrActiveActionSet active{appSet_, XR_NULL_PATH};
     XrActionsSyncInfo si{XR_TYPE_ACTIONS_SYNC_INFO};
     si.countActiveActionSets = 1;
@@ -277,6 +327,10 @@ class App {
       handMoved_ = o.position.x != 0.0f || o.position.y != 0.0f || o.position.z != 0.0f ||
                    o.orientation.x != 0.0f || o.orientation.y != 0.0f || o.orientation.z != 0.0f;
       cpuBuilds_ = build.cpuBuildCount;
+      gpuBuilds_ = build.gpuBuildCount;
+      gpuReady_ = build.sessionBackend == XR_GRASP_SDF_BACKEND_VULKAN_SDFG;
+      gpuFailed_ = build.gpuFailed == XR_TRUE;
+      graspBackend_ = build.graspBackend;
     }
     XrFrameEndInfo ei{XR_TYPE_FRAME_END_INFO};
     ei.displayTime = fs.predictedDisplayTime;
@@ -295,6 +349,37 @@ class App {
     return ms(Clock::now() - t0);
   }
 
+  // The object in the app's Vulkan buffers (a Vulkan session); the create call timed.
+  bool createBufferTarget(const Object& o, const XrPosef& pose, double& callMs,
+                          std::string& error) {
+    if (!uploadBuffers(o, error)) return false;
+    XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &bufferDesc_};
+    ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, local_, pose};
+    const auto t0 = Clock::now();
+    const XrResult r = createTarget_(session_, &ci, &target_);
+    callMs = ms(Clock::now() - t0);
+    if (r != XR_SUCCESS)
+      error = "xrCreateGraspTargetSDFG refused the Vulkan buffers (" + std::to_string(r) +
+              (r == XR_ERROR_FEATURE_UNSUPPORTED ? ": the session builds on the CPU" : "") + ")";
+    return r == XR_SUCCESS;
+  }
+  // The buffers alone (the layer-off run, so both runs do the same Vulkan work).
+  bool uploadBuffers(const Object& o, std::string& error) {
+    return vk_.uploadMesh(o, bufferDesc_, error);
+  }
+  // The skinning pass's new positions, submitted on the binding's queue (untimed: the app's own
+  // work, as the arrays' rescaling is); then, with the layer, "my buffers changed" (timed).
+  double updateBuffers(const std::vector<XrVector3f>& vertices, std::string& error) {
+    if (!vk_.writeVertices(vertices, error)) return 0.0;
+    if (!layer_) return 0.0;
+    const auto t0 = Clock::now();
+    const XrResult r = update_(target_, &bufferDesc_);
+    const double d = ms(Clock::now() - t0);
+    if (r != XR_SUCCESS)
+      error = "xrUpdateGraspTargetVerticesSDFG failed (" + std::to_string(r) + ")";
+    return d;
+  }
+
   double updateVertices(const std::vector<XrVector3f>& vertices) {
     XrGraspTargetVerticesSDFG v{XR_TYPE_GRASP_TARGET_VERTICES_SDFG};
     v.vertexCount = uint32_t(vertices.size());
@@ -310,6 +395,17 @@ class App {
   // The frame's XrGraspHandOffsetSDFG::offset (right hand) was not the identity.
   bool handMoved() const { return handMoved_; }
   uint64_t cpuBuilds() const { return cpuBuilds_; }
+  uint64_t gpuBuilds() const { return gpuBuilds_; }
+  // The session's GPU path is prepared (its next build goes to the device).
+  bool gpuReady() const { return gpuReady_; }
+  bool gpuFailed() const { return gpuFailed_; }
+  // Where the shown grasp's field was built: "vulkan", "cpu", or "none" when not grasping.
+  const char* graspBackend() const {
+    return graspBackend_ == XR_GRASP_SDF_BACKEND_VULKAN_SDFG ? "vulkan"
+           : graspBackend_ == XR_GRASP_SDF_BACKEND_CPU_SDFG  ? "cpu"
+                                                             : "none";
+  }
+  const VulkanApp& vulkan() const { return vk_; }
   uint64_t framesEnded() const { return framesEnded_; }
   bool layer() const { return layer_; }
 
@@ -358,6 +454,9 @@ class App {
   }
 
   bool layer_;
+  SessionKind sessionKind_;
+  VulkanApp vk_;  // a Vulkan session's instance, device and buffers (the app's own)
+  XrGraspTargetVulkanBuffersSDFG bufferDesc_{XR_TYPE_GRASP_TARGET_VULKAN_BUFFERS_SDFG};
   XrInstance instance_ = XR_NULL_HANDLE;
   XrSession session_ = XR_NULL_HANDLE;
   XrSpace local_ = XR_NULL_HANDLE;
@@ -369,6 +468,10 @@ class App {
   bool handMoved_ = false;
   std::vector<XrGraspTargetSDFG> others_;  // addTarget()'s
   uint64_t cpuBuilds_ = 0;                 // the session's CPU builds so far (XrGraspBuildInfoSDFG)
+  uint64_t gpuBuilds_ = 0;                 // and GPU builds
+  bool gpuReady_ = false;
+  bool gpuFailed_ = false;
+  XrGraspSdfBackendSDFG graspBackend_ = XR_GRASP_SDF_BACKEND_NONE_SDFG;
   XrGraspTargetSDFG target_ = XR_NULL_HANDLE;
   std::array<XrHandTrackerEXT, 2> trackers_{};
   std::array<XrHandJointLocationEXT, XR_HAND_JOINT_COUNT_EXT> joints_{};
@@ -380,10 +483,18 @@ class App {
   PFN_xrLocateHandJointsEXT locate_ = nullptr;
 };
 
-void setLayer(bool on) {
+// How the app runs (the command line's --session, --target, --gpu, --layer-dir).
+struct Settings {
+  SessionKind session = SessionKind::headless;
+  TargetKind target = TargetKind::arrays;
+  std::string gpu = "on";  // the layer's gpu key on a Vulkan session
+  std::string layerDir = SDFG_FC_LAYER_EXPLICIT_DIR;
+};
+
+void setLayer(bool on, const Settings& settings) {
   if (on) {
     unsetenv(SDFG_FC_LAYER_DISABLE_ENV);
-    setenv("XR_API_LAYER_PATH", SDFG_FC_LAYER_EXPLICIT_DIR, 1);
+    setenv("XR_API_LAYER_PATH", settings.layerDir.c_str(), 1);
     setenv("XR_ENABLE_API_LAYERS", SDFG_FC_LAYER_NAME, 1);
   } else {
     // Off however it is installed: explicit not enabled, implicit disabled.
@@ -402,11 +513,31 @@ XrPosef objectPose(const XrPosef& grip, float yawRadians) {
   return {{q.x, q.y, q.z, q.w}, {c.x, c.y, c.z}};
 }
 
-RunResult run(const Object& object, bool layer, int phaseFrames) {
+// On a Vulkan session with the layer and its GPU path wanted: frames until the path is prepared
+// (pipelines made and warmed up off the app's calls; seconds on lavapipe with a cold shader
+// cache), at most 60 s, so the grab is built where it would be in a running app. Its time is
+// recorded apart from the target's set-up. False with `error` set when it never gets ready.
+bool waitForGpu(App& app, const Settings& settings, double& prepareMs, std::string& error) {
+  if (settings.session != SessionKind::vulkan || settings.gpu == "off") return true;
+  std::map<std::string, std::vector<double>> ignored;
+  const auto t0 = Clock::now();
+  while (!app.gpuReady() && !app.gpuFailed() && Clock::now() - t0 < 60s)
+    app.frame(ignored, [] { return 0.0; });
+  prepareMs = ms(Clock::now() - t0);
+  if (app.gpuReady()) return true;
+  error = app.gpuFailed() ? "the layer's GPU path failed (its log says why)"
+                          : "the layer's GPU path was not ready after 60 s";
+  return false;
+}
+
+RunResult run(const Object& object, bool layer, int phaseFrames, const Settings& settings) {
   RunResult out;
-  setLayer(layer);
-  App app(layer);
+  setLayer(layer, settings);
+  const bool buffer = settings.target == TargetKind::buffer;
+  App app(layer, settings.session);
   if (!app.init(out.error)) return out;
+  out.vulkanDevice = app.vulkan().deviceName();
+  out.vulkanDeviceType = app.vulkan().deviceType();
   const XrPosef grip = kGrip;
   const XrPosef pose0 = objectPose(grip, 0.0f);
   auto none = [] { return 0.0; };
@@ -416,8 +547,10 @@ RunResult run(const Object& object, bool layer, int phaseFrames) {
     return out;
   }
   if (layer) {
-    if (!app.createTarget(object, pose0, out.createMs)) {
-      out.error = "xrCreateGraspTargetSDFG refused the mesh";
+    if (!waitForGpu(app, settings, out.gpuPrepareMs, out.error)) return out;
+    if (buffer ? !app.createBufferTarget(object, pose0, out.createMs, out.error)
+               : !app.createTarget(object, pose0, out.createMs)) {
+      if (!buffer) out.error = "xrCreateGraspTargetSDFG refused the mesh";
       return out;
     }
     // The set-up runs on the layer's worker; frames go on meanwhile (at most 60 s).
@@ -429,13 +562,17 @@ RunResult run(const Object& object, bool layer, int phaseFrames) {
       return out;
     }
   } else {
+    if (buffer && !app.uploadBuffers(object, out.error)) return out;
     app.frame(ignored, none);
   }
   // Open hand.
   uint64_t buildsBefore = app.cpuBuilds();
+  uint64_t gpuBuildsBefore = app.gpuBuilds();
   auto endPhase = [&](int phase) {
     out.builds[phase] = app.cpuBuilds() - buildsBefore;
     buildsBefore = app.cpuBuilds();
+    out.gpuBuilds[phase] = app.gpuBuilds() - gpuBuildsBefore;
+    gpuBuildsBefore = app.gpuBuilds();
   };
   for (int i = 0; i < phaseFrames; ++i) out.frameMs[0].push_back(app.frame(out.callMs, none));
   endPhase(0);
@@ -449,6 +586,7 @@ RunResult run(const Object& object, bool layer, int phaseFrames) {
     if (layer && app.grasping()) {
       out.grabLatencyFrames = i;  // 0: shown by the frame the squeeze crossed in
       out.grasped = true;
+      out.graspBackend = app.graspBackend();
       break;
     }
   }
@@ -472,35 +610,51 @@ RunResult run(const Object& object, bool layer, int phaseFrames) {
     }));
   }
   endPhase(3);
-  // Held, deforming: every vertex rescaled about the centre each frame (down to 94 %).
+  // Held, deforming: every vertex rescaled about the centre each frame (down to 94 %). Arrays:
+  // handed over before the frame. Buffers: written on the binding's queue inside the frame,
+  // then announced, as a skinned mesh's app does (docs/layer.md).
   std::vector<XrVector3f> scaled = object.vertices;
-  for (int i = 1; i <= phaseFrames; ++i) {
+  auto timedUpdate = [&](double d) {
+    out.callMs["xrUpdateGraspTargetVerticesSDFG"].push_back(d);
+    out.maxUpdateCallMs = std::max(out.maxUpdateCallMs, d);
+    return d;
+  };
+  for (int i = 1; i <= phaseFrames && out.error.empty(); ++i) {
     const float k = 1.0f - 0.06f * float(i) / float(phaseFrames);
     for (size_t v = 0; v < scaled.size(); ++v)
       scaled[v] = {object.vertices[v].x * k, object.vertices[v].y * k, object.vertices[v].z * k};
-    out.frameMs[4].push_back(app.frame(out.callMs, [&] {
-      if (!layer) return 0.0;
-      const double d = app.updateVertices(scaled);
-      out.callMs["xrUpdateGraspTargetVerticesSDFG"].push_back(d);
-      out.maxUpdateCallMs = std::max(out.maxUpdateCallMs, d);
-      return d;
-    }));
+    out.frameMs[4].push_back(app.frame(
+        out.callMs,
+        [&] {
+          if (!layer || buffer) return 0.0;
+          return timedUpdate(app.updateVertices(scaled));
+        },
+        [&] {
+          if (!buffer) return 0.0;
+          const double d = app.updateBuffers(scaled, out.error);
+          return layer ? timedUpdate(d) : 0.0;
+        }));
   }
+  if (!out.error.empty()) return out;
   endPhase(4);
+  out.gpuFailed = app.gpuFailed();
   out.ok = true;
   return out;
 }
 
 // `outerHand`: the layer's outer_hand setting (through its environment variable).
-OuterRun runOuter(const OuterScene& scene, bool layer, bool outerHand, int phaseFrames) {
+OuterRun runOuter(const OuterScene& scene, bool layer, bool outerHand, int phaseFrames,
+                  const Settings& settings) {
   OuterRun out;
-  setLayer(layer);
+  setLayer(layer, settings);
   if (outerHand)
     unsetenv("SDFG_AUTOGRASP_OUTER_HAND");
   else
     setenv("SDFG_AUTOGRASP_OUTER_HAND", "off", 1);
-  App app(layer);
+  App app(layer, settings.session);
   if (!app.init(out.error)) return out;
+  out.vulkanDevice = app.vulkan().deviceName();
+  out.vulkanDeviceType = app.vulkan().deviceType();
   auto none = [] { return 0.0; };
   std::map<std::string, std::vector<double>> ignored;
   if (!app.script(gripLine(0, scene.grip) + squeezeLine(0, 0.0f))) {
@@ -508,6 +662,8 @@ OuterRun runOuter(const OuterScene& scene, bool layer, bool outerHand, int phase
     return out;
   }
   if (layer) {
+    double prepareMs = 0;
+    if (!waitForGpu(app, settings, prepareMs, out.error)) return out;
     const auto t0 = Clock::now();
     for (size_t i = 0; i < scene.objects.size(); ++i) {
       double call = 0;
@@ -551,6 +707,75 @@ OuterRun runOuter(const OuterScene& scene, bool layer, bool outerHand, int phase
   out.ok = true;
   return out;
 }
+
+// One of `names` (a, b or c), as the other options' errors say it.
+CLI::Option* addChoice(CLI::App& cli, const std::string& name, std::vector<std::string> names,
+                       std::string& out) {
+  return cli
+      .add_option_function<std::string>(
+          name,
+          [name, names, &out](const std::string& v) {
+            if (std::find(names.begin(), names.end(), v) != names.end()) {
+              out = v;
+              return;
+            }
+            std::string expected;
+            for (size_t i = 0; i < names.size(); ++i)
+              expected += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+            throw CLI::ValidationError(name, "\"" + v + "\" is not " + expected);
+          })
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+}
+
+// Why the loader could not use `manifest` (a layer's or a runtime's; `section` is "api_layer" or
+// "runtime"): unreadable, not JSON, no library_path, or a library_path naming no file (absolute,
+// or relative to the manifest's folder, as the loader reads it); empty when it can. A bare file
+// name is left to the dynamic linker's search, as the loader does.
+std::string manifestProblem(const std::filesystem::path& manifest, const char* section) {
+  namespace fs = std::filesystem;
+  if (!fs::is_regular_file(manifest)) return manifest.string() + " does not exist";
+  auto json = sdfg::tools::readJsonFile(manifest);
+  if (!json) return json.error().message;
+  const sdfg::tools::Json& j = *json;
+  if (!j.is_object() || !j.contains(section) || !j[section].is_object() ||
+      !j[section].contains("library_path") || !j[section]["library_path"].is_string())
+    return manifest.string() + " has no " + section + ".library_path";
+  const fs::path lib = j[section]["library_path"].get<std::string>();
+  if (!lib.has_parent_path()) return {};
+  const fs::path resolved = lib.is_absolute() ? lib : manifest.parent_path() / lib;
+  if (fs::is_regular_file(resolved)) return {};
+  std::string why = manifest.string() + " names the library " + lib.string() + ", which is not " +
+                    "there" + (lib.is_absolute() ? "" : " (" + resolved.string() + ")");
+  // The build tree's layer manifest names its library by absolute path: a moved copy needs one
+  // beside the library with a relative path.
+  if (lib.is_absolute())
+    why +=
+        "; a copy on another machine needs a manifest whose library_path is relative "
+        "(tools/frame-cost/package-for-device.sh writes one)";
+  return why;
+}
+
+// The manifest of our layer in `dir` (XR_API_LAYER_PATH: the loader reads every *.json there),
+// or why there is none usable.
+std::string layerDirProblem(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return dir.string() + " is not a folder";
+  std::string problems;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    if (e.path().extension() != ".json") continue;
+    auto json = sdfg::tools::readJsonFile(e.path());
+    if (!json || !json->is_object() || !json->contains("api_layer") ||
+        !(*json)["api_layer"].is_object() ||
+        (*json)["api_layer"].value("name", std::string()) != SDFG_FC_LAYER_NAME)
+      continue;
+    const std::string why = manifestProblem(e.path(), "api_layer");
+    if (why.empty()) return {};
+    problems += "; " + why;
+  }
+  return dir.string() + " has no usable manifest of " + SDFG_FC_LAYER_NAME +
+         (problems.empty() ? " (a *.json whose api_layer.name is it)" : problems);
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -559,6 +784,9 @@ int main(int argc, char** argv) {
   bool embeddedOnly = false;
   std::string json;
   std::vector<std::string> onlyNames;
+  std::string sessionName = "headless", targetName = "arrays", gpu, runtimeJson;
+  std::string meshesDir = SDFG_FC_SHARED_MESHES;
+  Settings settings;
   CLI::App cli{"", "autograsp-frame-cost"};
   // Fewer than 2 frames per phase leave nothing to take percentiles of: raised to 2, as always.
   sdfg::tools::cli::addInteger(
@@ -568,19 +796,62 @@ int main(int argc, char** argv) {
   sdfg::tools::cli::addInteger(cli, "--room", room, 5, 100000);
   sdfg::tools::cli::addName(cli, "--json", json, "file name");
   sdfg::tools::cli::addRepeatable(cli, "--only", onlyNames);
+  addChoice(cli, "--session", {"headless", "vulkan"}, sessionName);
+  addChoice(cli, "--target", {"arrays", "buffer"}, targetName);
+  addChoice(cli, "--gpu", {"auto", "on", "off"}, gpu);
+  sdfg::tools::cli::addName(cli, "--layer-dir", settings.layerDir, "folder name");
+  sdfg::tools::cli::addName(cli, "--runtime-json", runtimeJson, "file name");
+  sdfg::tools::cli::addName(cli, "--meshes", meshesDir, "folder name");
   if (auto exit = sdfg::tools::cli::parseOrUsage(cli, argc, argv, "autograsp-frame-cost", kUsage))
     return *exit;
+  auto usageError = [](const std::string& message) {
+    std::fprintf(stderr, "autograsp-frame-cost: %s\n%s", message.c_str(), kUsage);
+    return 2;
+  };
+  settings.session = sessionName == "vulkan" ? SessionKind::vulkan : SessionKind::headless;
+  settings.target = targetName == "buffer" ? TargetKind::buffer : TargetKind::arrays;
+  if (settings.session == SessionKind::headless && !gpu.empty())
+    return usageError("--gpu: only with --session vulkan (a headless session builds on the CPU)");
+  if (settings.target == TargetKind::buffer && settings.session != SessionKind::vulkan)
+    return usageError(
+        "--target buffer: needs --session vulkan (the buffers are the app's "
+        "Vulkan buffers)");
+  if (!gpu.empty()) settings.gpu = gpu;
+  if (settings.target == TargetKind::buffer && settings.gpu == "off")
+    return usageError(
+        "--target buffer with --gpu off: the layer refuses buffer targets when "
+        "it builds on the CPU");
   const std::set<std::string> only(onlyNames.begin(), onlyNames.end());
-  if (std::getenv("XR_RUNTIME_JSON") == nullptr)
+  // Where the loader finds the mock runtime: --runtime-json, else the environment's, else the
+  // build tree's. Checked here so a moved copy says what is missing rather than failing in
+  // xrCreateInstance.
+  if (!runtimeJson.empty())
+    setenv("XR_RUNTIME_JSON", runtimeJson.c_str(), 1);
+  else if (std::getenv("XR_RUNTIME_JSON") == nullptr)
     setenv("XR_RUNTIME_JSON", SDFG_FC_MOCK_RUNTIME_JSON, 1);
+  if (const std::string why = manifestProblem(std::getenv("XR_RUNTIME_JSON"), "runtime");
+      !why.empty()) {
+    std::fprintf(stderr, "autograsp-frame-cost: the runtime manifest (%s): %s\n",
+                 runtimeJson.empty() ? "XR_RUNTIME_JSON or the build tree's; --runtime-json FILE"
+                                     : "--runtime-json",
+                 why.c_str());
+    return 2;
+  }
+  if (const std::string why = layerDirProblem(settings.layerDir); !why.empty()) {
+    std::fprintf(stderr, "autograsp-frame-cost: the layer (--layer-dir DIR): %s\n", why.c_str());
+    return 2;
+  }
   setenv("SDFG_MOCK_HAND_TRACKING", "absent", 1);  // controllers only: the layer makes the hands
+  // The layer reads its settings' environment variables at xrCreateInstance (docs/layer.md).
+  if (settings.session == SessionKind::vulkan)
+    setenv("SDFG_AUTOGRASP_GPU", settings.gpu.c_str(), 1);
 
   std::vector<Object> objects;
   for (const sdfg::NamedMesh& m : sdfg::embeddedObjects())
     objects.push_back(toObject(m.name, m.mesh, 0.10f));
   std::vector<std::string> skipped;
   if (!embeddedOnly) {
-    const std::filesystem::path dir = SDFG_FC_SHARED_MESHES;
+    const std::filesystem::path dir = meshesDir;
     for (const char* file : {"stanford-bunny.obj", "stanford-armadillo-100k.obj",
                              "stanford-armadillo-400k-subdiv.obj"}) {
       const std::string name = std::filesystem::path(file).stem().string();
@@ -609,10 +880,10 @@ int main(int argc, char** argv) {
     r.triangles = o.indices.size() / 3;
     std::printf("%s (%zu triangles): layer off...", r.name.c_str(), r.triangles);
     std::fflush(stdout);
-    r.off = run(o, false, phaseFrames);
+    r.off = run(o, false, phaseFrames, settings);
     std::printf(" on...");
     std::fflush(stdout);
-    r.on = run(o, true, phaseFrames);
+    r.on = run(o, true, phaseFrames, settings);
     std::printf(" done\n");
     r.ok = r.off.ok && r.on.ok;
     r.error = !r.off.ok ? "layer off: " + r.off.error : !r.on.ok ? "layer on: " + r.on.error : "";
@@ -623,6 +894,29 @@ int main(int argc, char** argv) {
     results.push_back(std::move(r));
   }
 
+  // The session the figures come from, and on a Vulkan session the device (any run that made one:
+  // every run's is the first the runtime names).
+  SessionInfo session;
+  session.session = sessionName;
+  session.target = targetName;
+  if (settings.session == SessionKind::vulkan) session.gpu = settings.gpu;
+  for (const MeshResult& r : results)
+    for (const RunResult* run : {&r.on, &r.off})
+      if (session.vulkanDevice.empty() && !run->vulkanDevice.empty()) {
+        session.vulkanDevice = run->vulkanDevice;
+        session.vulkanDeviceType = run->vulkanDeviceType;
+      }
+  // `arrays`: the outer-hand scenario, whose targets are always arrays.
+  auto printSession = [&](bool arrays) {
+    if (settings.session != SessionKind::vulkan) return;
+    std::printf("Vulkan session on %s (%s); targets %s; the layer's gpu = %s\n\n",
+                session.vulkanDevice.empty() ? "no device" : session.vulkanDevice.c_str(),
+                session.vulkanDeviceType.c_str(),
+                settings.target == TargetKind::buffer && !arrays ? "in the app's Vulkan buffers"
+                                                                 : "as arrays",
+                settings.gpu.c_str());
+  };
+
   int failures = 0;
   // The objects' table, unless only the outer-hand scenario ran.
   if (!results.empty() || !skipped.empty()) {
@@ -630,6 +924,7 @@ int main(int argc, char** argv) {
         "\nTime the layer adds to the app's OpenXR calls per frame (ms; layer on minus the "
         "layer-off median of the phase), 90 Hz pacing, %d frames per phase; code at commit %s\n\n",
         phaseFrames, sdfg::tools::describeBuild().c_str());
+    printSession(false);
     std::printf("| object | triangles | create call | set-up | grab latency (frames) |");
     for (const char* p : kPhases) std::printf(" %s p50 / p99 / max |", p);
     std::printf("\n|---|---:|---:|---:|---:|");
@@ -658,15 +953,20 @@ int main(int argc, char** argv) {
     r.inHandBox = scene.inHandBox;
     std::printf("\nouter (%d targets, %d in the hand's box): layer off...", r.targets, r.inHandBox);
     std::fflush(stdout);
-    r.off = runOuter(scene, false, true, phaseFrames);
+    r.off = runOuter(scene, false, true, phaseFrames, settings);
     std::printf(" on...");
     std::fflush(stdout);
-    r.on = runOuter(scene, true, true, phaseFrames);
+    r.on = runOuter(scene, true, true, phaseFrames, settings);
     std::printf(" on without the outer hand...");
     std::fflush(stdout);
-    r.onWithoutOuter = runOuter(scene, true, false, phaseFrames);
+    r.onWithoutOuter = runOuter(scene, true, false, phaseFrames, settings);
     unsetenv("SDFG_AUTOGRASP_OUTER_HAND");
     std::printf(" done\n");
+    for (const OuterRun* run : {&r.on, &r.off})
+      if (session.vulkanDevice.empty() && !run->vulkanDevice.empty()) {
+        session.vulkanDevice = run->vulkanDevice;
+        session.vulkanDeviceType = run->vulkanDeviceType;
+      }
     r.ok = r.off.ok && r.on.ok && r.onWithoutOuter.ok;
     r.error = !r.off.ok              ? "layer off: " + r.off.error
               : !r.on.ok             ? "layer on: " + r.on.error
@@ -681,6 +981,7 @@ int main(int argc, char** argv) {
         "\nThe outer hand: time the layer adds per frame (ms), open hand near, then pressed into "
         "and sliding along, the targets in its box; code at commit %s\n\n",
         sdfg::tools::describeBuild().c_str());
+    printSession(true);
     std::printf(
         "| layer | targets | in hand box | create calls total / max | set-up | near p50 / p99 / "
         "max | "
@@ -705,9 +1006,9 @@ int main(int argc, char** argv) {
     outer = std::move(r);
   }
   if (!json.empty()) {
-    if (auto error =
-            sdfg::tools::writeJsonFile(json, resultsJson(results, phaseFrames, ms(kFramePeriod),
-                                                         skipped, outer ? &*outer : nullptr))) {
+    if (auto error = sdfg::tools::writeJsonFile(
+            json, resultsJson(results, phaseFrames, ms(kFramePeriod), skipped,
+                              outer ? &*outer : nullptr, &session))) {
       std::fprintf(stderr, "autograsp-frame-cost: %s\n", error->message.c_str());
       return 1;
     }

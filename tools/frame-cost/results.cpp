@@ -44,11 +44,20 @@ Percentiles addedOver(const std::vector<double>& frameMs, double offMedianMs) {
 
 tools::Json resultsJson(const std::vector<MeshResult>& results, int phaseFrames,
                         double framePeriodMs, const std::vector<std::string>& skipped,
-                        const OuterResult* outer) {
+                        const OuterResult* outer, const SessionInfo* session) {
   using tools::Json;
   using tools::jsonNumber;
+  const bool vulkan = session != nullptr && session->session == "vulkan";
   Json out;
   out["tool"] = "autograsp-frame-cost";
+  if (vulkan) {
+    // Which device made the figures: a GPU's and lavapipe's differ by orders of magnitude.
+    out["session"] = session->session;
+    out["target"] = session->target;
+    out["gpu"] = session->gpu;
+    out["vulkan_device"] = session->vulkanDevice;
+    out["vulkan_device_type"] = session->vulkanDeviceType;
+  }
   out["frames_per_phase"] = phaseFrames;
   out["frame_period_ms"] = jsonNumber(framePeriodMs);
   out["hardware_threads"] = std::thread::hardware_concurrency();
@@ -65,10 +74,16 @@ tools::Json resultsJson(const std::vector<MeshResult>& results, int phaseFrames,
     m["setup_ms"] = jsonNumber(r.on.setupMs);
     m["max_vertex_update_call_ms"] = jsonNumber(r.on.maxUpdateCallMs);
     m["grab_latency_frames"] = r.on.grabLatencyFrames;
+    if (vulkan) {
+      m["gpu_prepare_ms"] = jsonNumber(r.on.gpuPrepareMs);
+      m["grasp_backend"] = r.on.graspBackend;
+      m["gpu_failed"] = r.on.gpuFailed;
+    }
     Json& phases = m["phases"] = Json::object();
     for (int p = 0; p < kPhaseCount; ++p) {
       Json& phase = phases[kPhases[p]] = phaseJson(r.added[p], r.offStats[p]);
       phase["cpu_builds"] = r.on.builds[p];
+      if (vulkan) phase["gpu_builds"] = r.on.gpuBuilds[p];
     }
     m["calls_on"] = callsJson(r.on.callMs);
     meshes.push_back(std::move(m));
@@ -83,6 +98,7 @@ tools::Json resultsJson(const std::vector<MeshResult>& results, int phaseFrames,
     o["create_calls_total_ms"] = jsonNumber(r.on.createTotalMs);
     o["create_call_max_ms"] = jsonNumber(r.on.createMaxMs);
     o["setup_ms"] = jsonNumber(r.on.setupMs);
+    if (vulkan) o["target"] = "arrays";  // the outer hand keeps hands out of CPU meshes only
     Json& phases = o["phases"] = Json::object();
     for (int p = 0; p < kOuterPhaseCount; ++p) {
       Json& phase = phases[kOuterPhases[p]] = phaseJson(r.added[p], r.offStats[p]);

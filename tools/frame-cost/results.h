@@ -38,6 +38,13 @@ struct RunResult {
   double setupMs = 0;   // from create until the target is ready
   double maxUpdateCallMs = 0;
   std::array<uint64_t, kPhaseCount> builds{};  // CPU grab-box builds during each phase
+  // Vulkan sessions (--session vulkan) only:
+  std::array<uint64_t, kPhaseCount> gpuBuilds{};  // GPU grab-box builds during each phase
+  double gpuPrepareMs = 0;       // from the session's start until its GPU path was ready
+  std::string graspBackend;      // where the shown grasp's field was built: "vulkan", "cpu"
+  bool gpuFailed = false;        // the layer's GPU path failed (it builds on the CPU since)
+  std::string vulkanDevice;      // VkPhysicalDeviceProperties::deviceName
+  std::string vulkanDeviceType;  // "discrete-gpu", "cpu", ...
 };
 
 struct MeshResult {
@@ -66,6 +73,8 @@ struct OuterRun {
   double createTotalMs = 0;  // every xrCreateGraspTargetSDFG call
   double createMaxMs = 0;    // the slowest one
   double setupMs = 0;        // from the first create until every target is ready
+  // --session vulkan: as RunResult's.
+  std::string vulkanDevice, vulkanDeviceType;
 };
 
 struct OuterResult {
@@ -80,15 +89,25 @@ struct OuterResult {
   std::array<Percentiles, kOuterPhaseCount> offStats;
 };
 
+// How the app ran (--session, --target, --gpu) and on which Vulkan device. The JSON of a headless
+// run has none of these keys, as before they existed: a file without "session" is headless.
+struct SessionInfo {
+  std::string session = "headless";  // "headless" or "vulkan"
+  std::string target = "arrays";     // the objects' targets: "arrays" or "buffer"
+  std::string gpu;                   // the layer's gpu setting the tool set (vulkan)
+  std::string vulkanDevice, vulkanDeviceType;
+};
+
 // What the layer adds per frame: each of `frameMs` (layer on) less `offMedianMs` (the layer-off
 // run's median of the same phase).
 Percentiles addedOver(const std::vector<double>& frameMs, double offMedianMs);
 
 // The results as JSON: the settings, the provenance of the build (json_file.h), the objects
 // skipped (not found or unreadable), and per object its calls, set-up, grab latency and, per
-// phase, the time added per frame; with `outer`, the outer-hand scenario as "outer".
+// phase, the time added per frame; with `outer`, the outer-hand scenario as "outer"; with a
+// Vulkan `session`, its kind, target kind and device, and per object and phase the GPU's share.
 tools::Json resultsJson(const std::vector<MeshResult>& results, int phaseFrames,
                         double framePeriodMs, const std::vector<std::string>& skipped,
-                        const OuterResult* outer = nullptr);
+                        const OuterResult* outer = nullptr, const SessionInfo* session = nullptr);
 
 }  // namespace sdfg::frame_cost

@@ -2,7 +2,7 @@
 # numbers; --exact-check off leaves the exact check out of the "ours" rows; a broken mesh file is
 # named, skipped, and the rest still runs; bad option values are a usage error (exit 2);
 # --sdf-backend vulkan without a device leaves its rows out and exits 3; --scenes writes every
-# method's scene figures.
+# method's scene figures; --variants adds a row per split-vertex variant of each object.
 # With -DPART=vulkan (a Vulkan device, e.g. lavapipe): --sdf-backend cpu,vulkan gives both rows
 # with finite figures, and --scaling-quick both columns; no device prints SDFG_SKIPPED.
 # Usage: cmake -DBENCH=<autograsp-bench> -DWORK=<scratch dir> [-DPART=vulkan] -P bench_cli_test.cmake
@@ -212,6 +212,41 @@ if(NOT rc EQUAL 2)
   message(FATAL_ERROR "--clear-hand maybe: exit ${rc}, expected 2 (usage)\n${err}")
 endif()
 
+# 1e. --variants: each object again with its vertices split (soup, flat, seams), one row per
+# variant and method named "<object>/<variant>", on the object's placements; the JSON says which.
+execute_process(COMMAND "${BENCH}" --embedded-only --placements 3 --seed 2 --methods
+  ours,physics-mesh --variants soup,flat,seams --json "${WORK}/variants.json"
+  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "--variants exited ${rc}\n${out}\n${err}")
+endif()
+file(READ "${WORK}/variants.json" json)
+row_keys("${json}" keys)
+foreach(mesh mug torus thin-plate)
+  foreach(variant "" /soup /flat /seams)
+    foreach(key "${mesh}${variant}/ours/cpu" "${mesh}${variant}/physics-mesh/none")
+      if(NOT key IN_LIST keys)
+        message(FATAL_ERROR "--variants: no row ${key}; rows: ${keys}")
+      endif()
+    endforeach()
+  endforeach()
+endforeach()
+list(LENGTH keys n)
+if(NOT n EQUAL 24)
+  message(FATAL_ERROR "--variants: expected 24 rows (3 objects x 4 meshes x 2 methods): ${keys}")
+endif()
+check_rows("${json}" 3)
+string(JSON variants GET "${json}" variants)
+if(NOT variants STREQUAL "[ \"soup\", \"flat\", \"seams\" ]")
+  message(FATAL_ERROR "--variants: the JSON's \"variants\" is ${variants}")
+endif()
+# Without --variants the JSON has no such key (the earlier run's out.json).
+file(READ "${WORK}/out.json" json)
+string(JSON variants ERROR_VARIABLE err GET "${json}" variants)
+if(NOT err)
+  message(FATAL_ERROR "a run without --variants wrote \"variants\": ${variants}")
+endif()
+
 # 1d. --scenes: every method in every embedded scene, with the scene figures in the JSON and the
 # table; the names of the scenes of several objects are there.
 execute_process(COMMAND "${BENCH}" --embedded-only --placements 3 --seed 2 --scenes
@@ -279,7 +314,8 @@ check_row("${json}" 0 3)
 # octal or hexadecimal), a negative seed, two values after a single --mesh.
 foreach(args "--placements;abc" "--methods;nope" "--resolution;1" "--da;0" "--bogus"
     "--sdf-backend;gpu" "--sdf-backend;," "--exact-check;maybe" "--exact-check"
-    "--placements;0x10" "--seed;-1" "--da;nan" "--mesh;a.obj;b.obj" "--json;")
+    "--placements;0x10" "--seed;-1" "--da;nan" "--mesh;a.obj;b.obj" "--json;"
+    "--variants;welded")
   execute_process(COMMAND "${BENCH}" ${args} RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
   if(NOT rc EQUAL 2 OR NOT err MATCHES "usage")
     message(FATAL_ERROR "\"${args}\" exited ${rc}, expected 2 with usage:\n${err}")

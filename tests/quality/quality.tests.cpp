@@ -8,18 +8,21 @@
 // 1000, no finger passing through; and per object, contacts per grasp no lower than measured at
 // the commit that set the gate (see kObjects). Each object is its own test case, so an absent
 // research mesh is skipped before any assertion and a present one is judged. Each case prints
-// its figures (a passing run's log shows them).
+// its figures (a passing run's log shows them). Every object is also graded with its vertices
+// split as game exporters split them (soup, flat, seams; see "Split vertices" below).
 #include <catch2/catch.hpp>
 
 #include <cstdio>
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "eval/quality.h"
 #include "eval/scene_quality.h"
 #include "eval/scenes.h"
 #include "io/mesh_io.h"
+#include "io/mesh_variants.h"
 #include "io/shapes.h"
 #include "test_support.h"
 
@@ -53,11 +56,15 @@ constexpr Gate kMug{1000, 4.77};
 constexpr Gate kTorus{1000, 4.64};
 constexpr Gate kThinPlate{1000, 4.60};
 
-void checkQuality(const std::string& name, const TriangleMesh& mesh, const Gate& gate) {
+// `reference`: the surface `mesh` is a variant of (io/mesh_variants.h), which the placements and
+// the grading use while "ours" solves on `mesh`.
+void checkQuality(const std::string& name, const TriangleMesh& mesh, const Gate& gate,
+                  const TriangleMesh* reference = nullptr) {
   QualityRun run;
   run.placements = gate.placements;
   run.seed = kSeed;
   run.threads = kThreads;
+  run.reference = reference;
   const Result<QualityFigures> measured = measureQuality(mesh, run);
   REQUIRE(measured.ok());
   const QualityFigures& q = *measured;
@@ -79,13 +86,33 @@ void checkQuality(const std::string& name, const TriangleMesh& mesh, const Gate&
   CHECK(q.passThroughs == 0);
 }
 
-void checkEmbedded(const std::string& name, const Gate& gate) {
+TriangleMesh embeddedMesh(const std::string& name) {
   std::optional<TriangleMesh> mesh;
   for (const NamedMesh& o : embeddedObjects()) {
     if (o.name == name) mesh = o.mesh;
   }
   REQUIRE(mesh.has_value());
-  checkQuality(name, *mesh, gate);
+  return *mesh;
+}
+
+void checkEmbedded(const std::string& name, const Gate& gate) {
+  checkQuality(name, embeddedMesh(name), gate);
+}
+
+// `mesh` with its vertices split as `variant` (io/mesh_variants.h), solved on, and measured
+// against `mesh` itself.
+void checkVariant(const std::string& name, const TriangleMesh& mesh, std::string_view variant,
+                  const Gate& gate) {
+  const Result<TriangleMesh> split = makeMeshVariant(variant, mesh);
+  REQUIRE(split.ok());
+  std::printf("%s/%.*s: %zu vertices (%zu in the original), %zu triangles\n", name.c_str(),
+              int(variant.size()), variant.data(), split->vertexCount(), mesh.vertexCount(),
+              split->triangleCount());
+  checkQuality(name + "/" + std::string(variant), *split, gate, &mesh);
+}
+
+void checkEmbeddedVariant(const std::string& name, std::string_view variant, const Gate& gate) {
+  checkVariant(name, embeddedMesh(name), variant, gate);
 }
 
 }  // namespace
@@ -98,6 +125,19 @@ void checkEmbedded(const std::string& name, const Gate& gate) {
     const Result<LoadedMesh> loaded = loadMesh(*path);                                  \
     REQUIRE(loaded.ok());                                                               \
     checkQuality(file, loaded->mesh, gate);                                             \
+  } while (false)
+
+// A research mesh of ../shared/meshes as each variant in turn (loaded once: the load and the
+// original's exact query are most of such a case's time), or a skip where it is absent.
+#define SDFG_CHECK_SHARED_VARIANTS(file, gate)                                          \
+  do {                                                                                  \
+    const auto path = test::sharedMesh(file);                                           \
+    if (!path) SDFG_SKIP(std::string(file) + ": ../shared/meshes is not present here"); \
+    const Result<LoadedMesh> loaded = loadMesh(*path);                                  \
+    REQUIRE(loaded.ok());                                                               \
+    for (std::string_view variant : meshVariantNames()) {                               \
+      checkVariant(file, loaded->mesh, variant, gate);                                  \
+    }                                                                                   \
   } while (false)
 
 TEST_CASE("ours meets its published quality on the embedded mug", "[quality]") {
@@ -140,6 +180,111 @@ TEST_CASE("ours meets its published quality on the Stanford dragon", "[quality][
 
 TEST_CASE("ours meets its published quality on the Igea scan (268k)", "[quality][shared]") {
   SDFG_CHECK_SHARED("igea-268k.obj", (Gate{250, 4.88}));
+}
+
+// Split vertices (game meshes): every object again as a game exporter gives it
+// (io/mesh_variants.h): a triangle soup, flat shaded (split at edges whose faces turn by more
+// than 30 degrees) and box-mapped (split at the seams of 6 UV charts). "ours" solves on the
+// variant, its SDF and exact check built from it; the placements and the grading are the
+// original's (QualityRun::reference), so a figure moves only by what the split changes in the
+// solve. The surface is the same, so the gates are the original's, contacts per grasp included,
+// with no margin: every variant's figures equal the original's to the last printed digit, with
+// MeshDistance welding split vertices (3c0ad0e) and before it (8b95918), when a split mesh read
+// as open and was signed by the winding number. What splitting broke before the weld (the
+// layer's winding repair on a soup, the GPU's pseudo-normals) is not on this CPU path; these
+// cases keep the path the figures are published from independent of how vertices are shared.
+// The embedded objects run the original's 1000 placements; the research meshes the first 100 of
+// the same sequence (the label runs on 2 cores in CI).
+namespace {
+
+constexpr int kSharedVariantPlacements = 100;
+
+}  // namespace
+
+TEST_CASE("ours meets its published quality on the embedded mug as a triangle soup",
+          "[quality][variants]") {
+  checkEmbeddedVariant("mug", "soup", kMug);
+}
+
+TEST_CASE("ours meets its published quality on the embedded mug flat shaded",
+          "[quality][variants]") {
+  checkEmbeddedVariant("mug", "flat", kMug);
+}
+
+TEST_CASE("ours meets its published quality on the embedded mug with UV seams",
+          "[quality][variants]") {
+  checkEmbeddedVariant("mug", "seams", kMug);
+}
+
+TEST_CASE("ours meets its published quality on the embedded torus as a triangle soup",
+          "[quality][variants]") {
+  checkEmbeddedVariant("torus", "soup", kTorus);
+}
+
+TEST_CASE("ours meets its published quality on the embedded torus flat shaded",
+          "[quality][variants]") {
+  checkEmbeddedVariant("torus", "flat", kTorus);
+}
+
+TEST_CASE("ours meets its published quality on the embedded torus with UV seams",
+          "[quality][variants]") {
+  checkEmbeddedVariant("torus", "seams", kTorus);
+}
+
+TEST_CASE("ours meets its published quality on the embedded thin plate as a triangle soup",
+          "[quality][variants]") {
+  checkEmbeddedVariant("thin-plate", "soup", kThinPlate);
+}
+
+TEST_CASE("ours meets its published quality on the embedded thin plate flat shaded",
+          "[quality][variants]") {
+  checkEmbeddedVariant("thin-plate", "flat", kThinPlate);
+}
+
+TEST_CASE("ours meets its published quality on the embedded thin plate with UV seams",
+          "[quality][variants]") {
+  checkEmbeddedVariant("thin-plate", "seams", kThinPlate);
+}
+
+// The research meshes, one case each for its three variants. Contacts per grasp: the original's
+// over the same first 100 placements (measured at 3c0ad0e; the 250-placement gates above do not
+// hold for a prefix: the bunny's first 100 give 4.66 against 4.75), less half a contact in 100
+// grasps so the comparison is not one of floats at an exact hundredth.
+TEST_CASE("ours meets its published quality on the variants of the Stanford bunny",
+          "[quality][shared][variants]") {
+  SDFG_CHECK_SHARED_VARIANTS("stanford-bunny.obj", (Gate{kSharedVariantPlacements, 4.655}));
+}
+
+TEST_CASE("ours meets its published quality on the variants of the Newell teapot",
+          "[quality][shared][variants]") {
+  SDFG_CHECK_SHARED_VARIANTS("newell-teapot.obj", (Gate{kSharedVariantPlacements, 4.835}));
+}
+
+TEST_CASE("ours meets its published quality on the variants of the torus mesh",
+          "[quality][shared][variants]") {
+  SDFG_CHECK_SHARED_VARIANTS("torus.obj", (Gate{kSharedVariantPlacements, 4.605}));
+}
+
+TEST_CASE("ours meets its published quality on the variants of the Stanford armadillo (100k)",
+          "[quality][shared][variants]") {
+  SDFG_CHECK_SHARED_VARIANTS("stanford-armadillo-100k.obj",
+                             (Gate{kSharedVariantPlacements, 4.425}));
+}
+
+TEST_CASE("ours meets its published quality on the variants of the Stanford armadillo (400k)",
+          "[quality][shared][variants]") {
+  SDFG_CHECK_SHARED_VARIANTS("stanford-armadillo-400k-subdiv.obj",
+                             (Gate{kSharedVariantPlacements, 4.415}));
+}
+
+TEST_CASE("ours meets its published quality on the variants of the Stanford dragon",
+          "[quality][shared][variants]") {
+  SDFG_CHECK_SHARED_VARIANTS("stanford-dragon-100k.ply", (Gate{kSharedVariantPlacements, 4.345}));
+}
+
+TEST_CASE("ours meets its published quality on the variants of the Igea scan (268k)",
+          "[quality][shared][variants]") {
+  SDFG_CHECK_SHARED_VARIANTS("igea-268k.obj", (Gate{kSharedVariantPlacements, 4.885}));
 }
 
 // Scenes (issue 26, eval/scene_quality.h): "ours" among other objects keeps the whole hand out of

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <string>
+#include <string_view>
 
 #include "cli_options.h"
 #include "eval/strategies.h"
+#include "io/mesh_variants.h"
 
 namespace sdfg::bench {
 
@@ -40,6 +42,11 @@ const char* const kUsage =
     "                     the wrong object, and the single-object figures (--placements each)\n"
     "  --clear-hand on|off  on (default): \"ours\" moves an open hand that is inside the mesh\n"
     "                     out before closing (SolverOptions::clearance); off: as before\n"
+    "  --variants LIST    comma-separated: soup, flat, seams. Also run each mesh with its\n"
+    "                     vertices split as game exporters do (soup: every triangle its own\n"
+    "                     vertices; flat: hard edges over 30 degrees; seams: box-mapping UV\n"
+    "                     charts), rows \"<mesh>/<variant>\": solved on the variant, placements\n"
+    "                     and grading on the mesh as loaded (default: none; not in --scenes)\n"
     "  --json FILE        write the results as JSON\n"
     "  --report DIR       also write DIR/benchmarks.md with tables and plots (gnuplot) of this\n"
     "                     run, DIR/img/bench/*.png and DIR/bench-data/; implies --scaling\n"
@@ -74,6 +81,9 @@ std::optional<UsageError> parseOptions(int argc, char** argv, Options& o, bool& 
   cli::addInteger(app, "--resolution", o.resolution, kMinGridResolution, kMaxGridResolution);
   cli::addOnOff(app, "--exact-check", o.exactCheck);
   cli::addOnOff(app, "--clear-hand", o.clearHand);
+  std::vector<std::string> variantNames;
+  for (std::string_view v : meshVariantNames()) variantNames.emplace_back(v);
+  cli::addList(app, "--variants", variantNames, "variant", o.variants);
   cli::addInteger(app, "--threads", o.threads, 0, 1024);
   cli::addNumber(
       app, "--sdf-far-band", o.sdfFarBand, [](float x) { return x >= 0.0f; },

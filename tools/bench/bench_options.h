@@ -27,6 +27,9 @@ struct Options {
   // beside, inside and near others), figures in the JSON's "scenes" and the report.
   bool scenes = false;
   bool clearHand = true;  // --clear-hand: "ours" clears the open hand before closing
+  // --variants: also each mesh with its vertices split so (io/mesh_variants.h), rows named
+  // "<mesh>/<variant>", solved on the variant and measured against the mesh as loaded.
+  std::vector<std::string> variants;
   int placements = 1000;
   uint64_t seed = 1;
   std::vector<std::string> methods;

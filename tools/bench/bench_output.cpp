@@ -42,6 +42,8 @@ tools::Json resultsJson(const Options& o, const std::vector<Row>& rows) {
   out["resolution"] = o.resolution;
   out["seed"] = o.seed;
   out["exact_check"] = o.exactCheck;
+  // Only with --variants, so a run without keeps its JSON as before.
+  if (!o.variants.empty()) out["variants"] = o.variants;
   out["provenance"] = tools::provenanceJson();
   Json& rowsOut = out["rows"] = Json::array();
   const std::initializer_list<std::pair<const char*, double>> medianP95 = {{"median", 0.5},

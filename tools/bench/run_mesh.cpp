@@ -23,6 +23,7 @@
 #include "eval/approaching.h"
 #include "eval/evaluator.h"
 #include "eval/placements.h"
+#include "eval/quality.h"
 #include "eval/solver_physics.h"
 #include "eval/strategies.h"
 #include "grasp/solver.h"
@@ -161,12 +162,22 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
                                  const Options& o, const HandModel& hand, const GridBox& box,
                                  const std::vector<tools::TimedSdfBuilder*>& builders,
                                  unsigned threads, const Progress& progress,
-                                 PhaseSeconds& phaseSeconds) {
+                                 PhaseSeconds& phaseSeconds, const TriangleMesh* reference) {
   if (auto error = validateMesh(original.positions, original.indices)) {
     return makeError(error->code, error->message);
   }
-  const TriangleMesh mesh = normalizedToDiagonal(original, kHandSizeDiagonal);
-  auto distance = MeshDistance::create(mesh);
+  if (reference) {
+    if (auto error = validateMesh(reference->positions, reference->indices)) {
+      return makeError(error->code, "reference: " + error->message);
+    }
+  }
+  // `mesh` is what grasps are measured against (placements, grading), `solvedMesh` what the
+  // strategies read: the same unless a variant is solved on.
+  const TriangleMesh mesh =
+      normalizedToDiagonal(reference ? *reference : original, kHandSizeDiagonal);
+  const TriangleMesh solvedMesh =
+      reference ? normalizedLike(original, *reference, kHandSizeDiagonal) : mesh;
+  auto distance = MeshDistance::create(solvedMesh);
   if (!distance) return distance.error();
   auto exact = ExactMeshQuery::create(mesh);
   if (!exact) return exact.error();
@@ -189,7 +200,7 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
     }
     Method method{m, std::move(*solver), nullptr};
     if (method.solver->needsCollider()) {
-      auto collider = makeColliderFor(m, mesh);
+      auto collider = makeColliderFor(m, solvedMesh);
       if (!collider) return makeError(collider.error().code, m + ": " + collider.error().message);
       method.collider = std::move(*collider);
     }
@@ -198,7 +209,9 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
   }
   anyField = anyField && !builders.empty();
   for (tools::TimedSdfBuilder* b : builders) {
-    if (Status s = b->prepare(mesh, **distance); s != Status::ok) {
+    // The mesh as MeshDistance welded it, as the layer's GrabBoxSdf hands it to the GPU: a
+    // variant's split vertices would hide the topology the GPU's pseudo-normals read.
+    if (Status s = b->prepare((*distance)->mesh(), **distance); s != Status::ok) {
       return makeError(s, b->name() + " SDF builder: cannot take the mesh");
     }
   }
@@ -271,7 +284,7 @@ Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& or
       scene.objectFromHand = placement.objectFromHand;
       scene.collider = method.collider.get();
       // "ours" checks its stops on the exact distance of the same mesh the SDF is built from
-      // (unless --exact-check off).
+      // (unless --exact-check off): a variant's, as a game would give it.
       scene.exact = o.exactCheck ? &exactSource : nullptr;
       if (rowBuilder[r] >= 0) {
         scene.field = &grids[size_t(rowBuilder[r])];

@@ -95,11 +95,14 @@ struct PhaseSeconds {
 
 // Returns the rows of this mesh, or an error naming what failed: one row per physics method, one
 // per SDF method and builder (every builder builds the field of every placement; the SDF methods
-// solve on each in turn).
+// solve on each in turn). With a `reference` (--variants: the mesh `original` is a variant of),
+// the strategies read `original` (fields, exact check, colliders) while the placements and the
+// grading come from the reference, both scaled by the reference's bounds (normalizedLike()).
 Result<std::vector<Row>> runMesh(const std::string& name, const TriangleMesh& original,
                                  const Options& o, const HandModel& hand, const GridBox& box,
                                  const std::vector<tools::TimedSdfBuilder*>& builders,
                                  unsigned threads, const Progress& progress,
-                                 PhaseSeconds& phaseSeconds);
+                                 PhaseSeconds& phaseSeconds,
+                                 const TriangleMesh* reference = nullptr);
 
 }  // namespace sdfg::bench

@@ -8,6 +8,8 @@
 #include <thread>
 #include <vector>
 
+#include <glm/geometric.hpp>
+
 #include "eval/evaluator.h"
 #include "eval/percentile.h"
 #include "eval/placements.h"
@@ -25,15 +27,37 @@ struct Graded {
 
 }  // namespace
 
-Result<QualityFigures> measureQuality(const TriangleMesh& original, const QualityRun& run) {
-  if (auto error = validateMesh(original.positions, original.indices)) {
+TriangleMesh normalizedLike(const TriangleMesh& mesh, const TriangleMesh& reference,
+                            float diagonal) {
+  // normalizedToDiagonal()'s arithmetic, with the reference's bounds.
+  TriangleMesh out = mesh;
+  const Aabb box = computeBounds(reference.positions);
+  const float current = glm::length(box.extent());
+  const float scale = current > 0.0f ? diagonal / current : 1.0f;
+  const glm::vec3 centre = box.center();
+  for (glm::vec3& p : out.positions) p = (p - centre) * scale;
+  return out;
+}
+
+Result<QualityFigures> measureQuality(const TriangleMesh& given, const QualityRun& run) {
+  if (auto error = validateMesh(given.positions, given.indices)) {
     return makeError(error->code, error->message);
   }
   if (run.placements <= 0 || run.threads == 0) {
     return makeError(Status::invalid_argument, "quality: placements and threads must be positive");
   }
-  const TriangleMesh mesh = normalizedToDiagonal(original, kBenchObjectDiagonal);
-  auto distance = MeshDistance::create(mesh);
+  if (run.reference) {
+    if (auto error = validateMesh(run.reference->positions, run.reference->indices)) {
+      return makeError(error->code, "quality: reference: " + error->message);
+    }
+  }
+  // `solved` is what the strategy reads (its field and exact check), `mesh` what it is measured
+  // against (placements, grading): the same mesh unless a reference is given.
+  const TriangleMesh mesh =
+      normalizedToDiagonal(run.reference ? *run.reference : given, kBenchObjectDiagonal);
+  const TriangleMesh solved =
+      run.reference ? normalizedLike(given, *run.reference, kBenchObjectDiagonal) : mesh;
+  auto distance = MeshDistance::create(solved);
   if (!distance) return distance.error();
   auto exact = ExactMeshQuery::create(mesh);
   if (!exact) return exact.error();

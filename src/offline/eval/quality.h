@@ -7,6 +7,11 @@
 // exact mesh. Every figure is a pure function of the mesh, the settings and the seed (placements
 // are graded independently, so the thread count changes nothing), which is what lets a test hold
 // them to published values.
+//
+// With QualityRun::reference the strategy sees one mesh and the figures are measured on another
+// of the same surface: a mesh whose vertices are split as a game exporter splits them
+// (io/mesh_variants.h) is solved on, while the placements and the grading come from the original,
+// so a variant's figures differ from the original's only by what the split changed in the solve.
 #pragma once
 
 #include <cstdint>
@@ -31,6 +36,12 @@ struct QualityRun {
   SolverOptions options{};
   bool exactCheck = true;  // GraspScene::exact for the strategies that read it
   GridBox box = GridBox::referenceDefault();
+  // The surface the figures are measured against, when not the mesh solved on: placements are
+  // drawn on it and every grasp graded on its exact distance, while the SDF and the exact check
+  // the strategy reads come from the mesh given to measureQuality(). Both are scaled by the
+  // reference's bounds, so a variant with the reference's positions keeps them bit-identical.
+  // Null: the mesh itself. Not owned; must outlive the call.
+  const TriangleMesh* reference = nullptr;
 };
 
 // Figures in millimetres over the placements' grasps (residuals over fingers in contact).
@@ -68,9 +79,17 @@ class QualityTally {
   int touching_ = 0;
 };
 
+// `mesh` scaled and centred as normalizedToDiagonal(reference, diagonal) scales the reference:
+// the same arithmetic on the same coordinates, so a position `mesh` shares with the reference
+// stays bit-identical. (normalizedToDiagonal(mesh) would use the mesh's own bounds, which differ
+// where the reference has a vertex no triangle of `mesh` uses.) For QualityRun::reference and
+// the benchmark's variants.
+TriangleMesh normalizedLike(const TriangleMesh& mesh, const TriangleMesh& reference,
+                            float diagonal);
+
 // Runs `run` on `mesh` (any size and place: it is scaled to kBenchObjectDiagonal). Errors: an
-// invalid mesh, an unknown or non-SDF strategy, invalid options, fewer placements found than
-// asked (a mesh with no room for an open hand), or a failed build or solve (named).
+// invalid mesh or reference, an unknown or non-SDF strategy, invalid options, fewer placements
+// found than asked (a mesh with no room for an open hand), or a failed build or solve (named).
 Result<QualityFigures> measureQuality(const TriangleMesh& mesh, const QualityRun& run);
 
 }  // namespace sdfg

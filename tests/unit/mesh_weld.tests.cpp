@@ -93,7 +93,7 @@ TEST_CASE("A soup is closed and signed exactly as the indexed mesh", "[core][mes
   }
 }
 
-TEST_CASE("Near-equal positions weld; positions a tolerance apart never do", "[core][mesh]") {
+TEST_CASE("Near-equal positions weld, positions a tolerance apart never do", "[core][mesh]") {
   const TriangleMesh box = makeBox(glm::vec3(0.1f));
   const float diagonal = glm::length(computeBounds(box.positions).extent());
   TriangleMesh s = soup(box);

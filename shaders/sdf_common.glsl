@@ -5,8 +5,11 @@
 // Node (i, j, k) sits at (i, j, k) * spacing - size / 2 (src/sdf_grid.h).
 
 
-// Work-group size from the host (clamped to the device limits); 64 when not specialized.
+// Work-group size from the host (clamped to the device limits); 64 when not specialized. A pass
+// with a fixed size of its own (sdf_flood_group.comp) defines SDF_FIXED_LOCAL_SIZE first.
+#ifndef SDF_FIXED_LOCAL_SIZE
 layout(local_size_x_id = 0) in;
+#endif
 
 // Binding 0: per-build parameters (host-visible, written before each submission). A storage
 // buffer, not a uniform block: Mesa's lavapipe inlines uniform values into a recompiled shader

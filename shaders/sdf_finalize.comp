@@ -3,10 +3,11 @@
 // Pass 5, one invocation per node: the exact distance to the node's propagated closest triangle,
 // signed, on closed and consistently oriented meshes given as arrays, by the pseudo-normal of the
 // closest feature (as the CPU builder does), and otherwise by the generalized winding number of
-// the whole mesh (Jacobson et al. 2013): inside where it exceeds 0.5. The winding number is summed over the hierarchy of pass 2, exact for
-// triangles in nodes closer than beta * radius, the node's dipole term beyond (Barill et al.
-// 2018). It degrades gracefully at holes and needs no adjacency: the app's skinned buffers work
-// as they are.
+// the whole mesh (Jacobson et al. 2013): inside where it exceeds 0.5. The winding number is
+// summed over the hierarchy of pass 2, exact for triangles in nodes closer than beta * radius,
+// the node's dipole term beyond (Barill et al. 2018). It degrades gracefully at holes and needs
+// no adjacency: the app's skinned buffers work as they are. The pseudo-normal value and the
+// repair of sdf_repair.comp are in sdf_final.glsl, shared with sdf_flood_group.comp.
 #include "sdf_common.glsl"
 
 struct HierarchyNode {
@@ -22,13 +23,13 @@ layout(std430, set = 0, binding = 8) writeonly buffer Values { float values[]; }
 // Binding 5 (the splat's scratch, free by now): the values before sdf_repair, pseudo-normal mode.
 layout(std430, set = 0, binding = 5) writeonly buffer Unrepaired { float unrepaired[]; };
 
+// Only pseudoNormalValue() is used here; repairedValue() is sdf_repair.comp's.
+#define SDF_UNREPAIRED(i) 0.0
+#include "sdf_final.glsl"
+
 void store(uint v, float value) {
   if (P.signMode == 1u) unrepaired[v] = value; else values[v] = value;
 }
-
-// Binding 11: per triangle, object-space pseudo-normals of its edges 0..2 then corners 0..2
-// (equal-weight edge normals, angle-weighted vertex normals; Baerentzen & Aanaes 2005).
-layout(std430, set = 0, binding = 11) readonly buffer PseudoNormals { vec4 pseudoNormals[]; };
 
 layout(push_constant) uniform Push { uint step; uint flip; } pc;
 
@@ -85,24 +86,18 @@ void main() {
   if (v >= P.res.w) return;  // the dispatch is rounded up to whole groups
   vec3 p = nodePosition(nodeCoords(v));
   uint id = pc.flip == 0u ? idsA[v] : idsB[v];
+  if (P.signMode == 1u) {
+    store(v, pseudoNormalValue(p, id));
+    return;
+  }
   // No triangle within the cull margin: the surface is farther than the margin; spacing.w holds
-  // the value to report (the margin), signed below like every other node.
+  // the value to report (the margin), signed like every other node.
   if (id == kNoTriangle) {
-    store(v, P.signMode == 1u ? P.spacing.w : (windingNumber(p) > 0.5 ? -P.spacing.w : P.spacing.w));
+    store(v, windingNumber(p) > 0.5 ? -P.spacing.w : P.spacing.w);
     return;
   }
   vec3 a = tri[3u * id].xyz, b = tri[3u * id + 1u].xyz, c = tri[3u * id + 2u].xyz;
   uint feature;
-  vec3 q = closestOnTriangleFeature(p, a, b, c, feature);
-  float d = length(p - q);
-  bool inside;
-  if (P.signMode == 1u) {
-    // Closed, consistently oriented mesh: the side of the closest feature's pseudo-normal.
-    vec3 n = feature == 0u ? cross(b - a, c - a)
-                           : mat3(P.boxFromObject) * pseudoNormals[6u * id + feature - 1u].xyz;
-    inside = dot(p - q, n) < 0.0;
-  } else {
-    inside = windingNumber(p) > 0.5;
-  }
-  store(v, inside ? -d : d);
+  float d = length(p - closestOnTriangleFeature(p, a, b, c, feature));
+  store(v, windingNumber(p) > 0.5 ? -d : d);
 }

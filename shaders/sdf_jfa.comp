@@ -1,10 +1,13 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 // Pass 4, one invocation per node, once per jump step: jump flooding (Rong & Tan 2006) of
 // closest-triangle ids. A node looks at the 26 nodes `step` away and keeps, of its own and
 // their triangles, the one at the smallest exact distance from itself. Distances are always
 // exact point-triangle distances, so a propagated id can only make a node's value larger than
 // the true distance when the flood missed the true closest triangle.
+// Grids of up to 4096 nodes flood in one work group instead (sdf_flood_group.comp), with the
+// same result.
 #include "sdf_common.glsl"
 
 // Bindings 6 and 7: ping-pong id buffers; pc.flip picks the direction.
@@ -29,27 +32,31 @@ void main() {
     ivec3 base = ivec3(ijk);
     ivec3 n = ivec3(P.res.xyz);
     int s = int(pc.step);
+    // Every neighbour's id first, then the candidates: 27 loads in flight together instead of
+    // one after another (the pass waits on memory, not arithmetic). Same order as before: x
+    // fastest, then y, then z.
+    uint cands[27];
+    [[unroll]] for (int o = 0; o < 27; ++o) {
+      ivec3 q = base + (ivec3(o % 3, (o / 3) % 3, o / 9) - 1) * s;
+      bool inGrid = all(greaterThanEqual(q, ivec3(0))) && all(lessThan(q, n));
+      cands[o] =
+          inGrid ? readId(uint(q.x) + P.res.x * (uint(q.y) + P.res.y * uint(q.z))) : kNoTriangle;
+    }
     uint last = best;  // neighbours often share one id: evaluate a repeat only once
-    for (int dz = -1; dz <= 1; ++dz) {
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          ivec3 q = base + ivec3(dx, dy, dz) * s;
-          if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, n))) continue;
-          uint cand = readId(uint(q.x) + P.res.x * (uint(q.y) + P.res.y * uint(q.z)));
-          if (cand == kNoTriangle || cand == best || cand == last) continue;
-          last = cand;
-          // Lower bound from the sphere about corner a through the farther corner: a
-          // candidate that cannot beat the best skips the exact distance.
-          vec3 a = tri[3u * cand].xyz;
-          float reach = sqrt(max(dot(tri[3u * cand + 1u].xyz - a, tri[3u * cand + 1u].xyz - a),
-                                 dot(tri[3u * cand + 2u].xyz - a, tri[3u * cand + 2u].xyz - a)));
-          if (length(p - a) - reach >= bestD) continue;
-          float d = triangleDistance(p, cand);
-          if (d < bestD) {
-            bestD = d;
-            best = cand;
-          }
-        }
+    [[unroll]] for (int o = 0; o < 27; ++o) {
+      uint cand = cands[o];
+      if (cand == kNoTriangle || cand == best || cand == last) continue;
+      last = cand;
+      // Lower bound from the sphere about corner a through the farther corner: a candidate
+      // that cannot beat the best skips the exact distance.
+      vec3 a = tri[3u * cand].xyz;
+      float reach = sqrt(max(dot(tri[3u * cand + 1u].xyz - a, tri[3u * cand + 1u].xyz - a),
+                             dot(tri[3u * cand + 2u].xyz - a, tri[3u * cand + 2u].xyz - a)));
+      if (length(p - a) - reach >= bestD) continue;
+      float d = triangleDistance(p, cand);
+      if (d < bestD) {
+        bestD = d;
+        best = cand;
       }
     }
   }

@@ -4,8 +4,13 @@
 // of its bounding box grown by one node spacing (clamped to the grid, so a triangle outside the
 // box seeds the nearest boundary layer). Mode 0 keeps the smallest distance per node with an
 // atomic minimum on its bits (non-negative floats order like their bit patterns); mode 1 writes
-// the triangle id where its distance equals that minimum (any one of equal triangles wins).
+// the triangle id where its distance equals that minimum (the largest id of equal triangles, by
+// atomics, so the result does not depend on the order the device runs the triangles in).
 // Every node within one spacing of the surface ends with its exact closest triangle.
+//
+// Each triangle has 2^splitLog2 invocations, each taking every 2^splitLog2-th z layer of its
+// nodes: a small triangle's 4 x 4 x 4 nodes are then 4 short loops side by side instead of one
+// loop of 64 dependent memory operations, which on a GPU is what the pass waits for.
 #include "sdf_common.glsl"
 
 // Binding 5: per node, bits of the smallest distance found (cleared to +inf bits).
@@ -13,7 +18,7 @@ layout(std430, set = 0, binding = 5) buffer DistBits { uint distBits[]; };
 // Binding 6: per node, closest triangle id (cleared to kNoTriangle).
 layout(std430, set = 0, binding = 6) buffer IdsA { uint idsA[]; };
 
-layout(push_constant) uniform Push { uint mode; } pc;
+layout(push_constant) uniform Push { uint mode; uint splitLog2; } pc;
 
 uvec3 nodeRangeLow(vec3 lo) {
   vec3 f = floor((lo + P.boxHalf.xyz) / P.spacing.xyz) - 1.0;
@@ -25,7 +30,8 @@ uvec3 nodeRangeHigh(vec3 hi) {
 }
 
 void main() {
-  uint t = gl_GlobalInvocationID.x;
+  uint t = gl_GlobalInvocationID.x >> pc.splitLog2;
+  uint layer = gl_GlobalInvocationID.x & ((1u << pc.splitLog2) - 1u);
   if (t >= P.triangleCount) return;  // the dispatch is rounded up to whole groups
   vec4 a4 = tri[3u * t];
   if (a4.w != 1.0) return;  // outside the cull margin, or dropped
@@ -35,7 +41,7 @@ void main() {
   float seedReach = 2.0 * max(P.spacing.x, max(P.spacing.y, P.spacing.z));
   bool outside = any(greaterThan(max(a, max(b, c)), P.boxHalf.xyz)) ||
                  any(lessThan(min(a, min(b, c)), -P.boxHalf.xyz));
-  for (uint k = lo.z; k <= hi.z; ++k) {
+  for (uint k = lo.z + layer; k <= hi.z; k += 1u << pc.splitLog2) {
     for (uint j = lo.y; j <= hi.y; ++j) {
       for (uint i = lo.x; i <= hi.x; ++i) {
         uint v = i + P.res.x * (j + P.res.y * k);
@@ -52,7 +58,9 @@ void main() {
           // (many small triangles per node). A stale read only costs an unneeded atomic.
           if (bits < distBits[v]) atomicMin(distBits[v], bits);
         } else if (distBits[v] == bits) {
-          idsA[v] = t;
+          // The first equal triangle replaces kNoTriangle, a later larger id replaces it.
+          uint old = atomicCompSwap(idsA[v], kNoTriangle, t);
+          if (old != kNoTriangle && old < t) atomicMax(idsA[v], t);
         }
       }
     }

@@ -2,7 +2,9 @@
 #extension GL_GOOGLE_include_directive : require
 // Pass 1, one invocation per triangle: fetch its indices and positions from the mesh source (our
 // own upload or the app's buffers, any stride and 16/32-bit indices), move it into box space and
-// mark whether it lies within the cull margin of the box.
+// mark whether it lies within the cull margin of the box. The dispatch also covers every node:
+// invocation v clears node v's splat minimum and closest-triangle id for the splat that follows
+// (one pass instead of two buffer fills and the barrier between them and this pass).
 #include "sdf_common.glsl"
 
 // Binding 1: vertex positions, raw 32-bit words (float bits), offset and stride from P.
@@ -32,9 +34,19 @@ bool fetchPosition(uint v, out vec3 p) {
   return true;
 }
 
+// Binding 5: per node, bits of the splat's smallest distance (+inf bits when cleared).
+layout(std430, set = 0, binding = 5) writeonly buffer DistBits { uint distBits[]; };
+// Binding 6: per node, closest triangle id (kNoTriangle when cleared).
+layout(std430, set = 0, binding = 6) writeonly buffer IdsA { uint idsA[]; };
+
 void main() {
   uint t = gl_GlobalInvocationID.x;
-  if (t >= P.triangleCount) return;  // the dispatch is rounded up to whole groups
+  if (t < P.res.w) {
+    distBits[t] = 0x7f800000u;
+    idsA[t] = kNoTriangle;
+  }
+  // The dispatch covers max(triangles, nodes), rounded up to whole groups.
+  if (t >= P.triangleCount) return;
   vec3 p0, p1, p2;
   bool valid = fetchPosition(fetchIndex(3u * t), p0);
   valid = fetchPosition(fetchIndex(3u * t + 1u), p1) && valid;

@@ -30,6 +30,9 @@
 #include "mesh/mesh_distance.h"
 #include "sdf/sdf_grid.h"
 #include "sdf_backends.h"
+#ifdef SDFG_SCALING_VULKAN
+#include "vulkan/vk_sdf_builder_detail.h"
+#endif
 
 namespace {
 
@@ -39,15 +42,21 @@ using Clock = std::chrono::steady_clock;
 const char* const kUsage =
     "usage: autograsp-sdf-scaling [--meshes DIR] [--runs N] [--res 16,32,64] [--quick]\n"
     "                             [--profile] [--wg N] [--only torus|meshes] [--far-band M]\n"
+    "                             [--stepwise-flood]\n"
     "  --meshes DIR       folder of the test meshes (default ../shared/meshes)\n"
     "  --runs N           timed runs per row after one warm-up; the median is shown (default 5)\n"
     "  --res LIST         comma-separated grid resolutions, 2..128 (default 16,32,64)\n"
     "  --quick            tori up to 100k triangles only, no meshes\n"
-    "  --profile          add the Vulkan pass times (GPU timestamps) of the last run to each row\n"
+    "  --profile          add the Vulkan pass times (GPU timestamps) of the last run to each row:\n"
+    "                     transform, hierarchy, splat, flood, final, sample\n"
     "  --wg N             compute work-group size of the Vulkan builder (default 64)\n"
     "  --only torus|meshes  keep one group of rows\n"
     "  --far-band M       CPU builder far-field mode: CpuSdfOptions::exactBand = M metres\n"
     "                     (default 0, exact everywhere)\n"
+    "  --stepwise-flood   Vulkan: flood every grid with one dispatch per jump step, as grids\n"
+    "                     over 4096 nodes do, instead of small grids' one-group flood (which\n"
+    "                     also finalizes and samples: its pass times show final and sample as\n"
+    "                     0, counted in flood)\n"
     "  --help             this text\n"
     "exit codes: 0 done; 1 the CPU builder failed; 2 bad option\n";
 
@@ -80,10 +89,20 @@ int main(int argc, char** argv) {
       "a distance >= 0 in metres");
   app.add_flag("--profile", builderOptions.vulkanProfile);
   app.add_flag("--quick", quick);
+  bool stepwiseFlood = false;
+  app.add_flag("--stepwise-flood", stepwiseFlood);
   std::vector<long long> res;
   cli::addIntegerList(app, "--res", kMinGridResolution, kMaxGridResolution, "resolution", res);
   if (auto exit = cli::parseOrUsage(app, argc, argv, "autograsp-sdf-scaling", kUsage)) return *exit;
   if (!meshes.empty()) meshDir = meshes;
+  if (stepwiseFlood) {
+#ifdef SDFG_SCALING_VULKAN
+    vk_sdf_detail::floodTestHooks.forceStepwise = true;
+#else
+    std::fprintf(stderr, "--stepwise-flood: built without the Vulkan builder\n");
+    return 2;
+#endif
+  }
   if (!res.empty()) resolutions.assign(res.begin(), res.end());
   if (!only.empty()) {
     // --only torus,meshes keeps both, as no --only does.

@@ -76,12 +76,17 @@ Result<std::unique_ptr<VkSdfBuilder>> VkSdfBuilder::create(const VulkanDevice& d
   o.pipelineLayout = VkOwned<VkPipelineLayout>(c, pipelineLayout);
 
   const std::array<std::span<const uint32_t>, kPassCount> code = {
-      spirv::k_sdf_transform, spirv::k_sdf_cluster, spirv::k_sdf_splat, spirv::k_sdf_jfa,
-      spirv::k_sdf_finalize,  spirv::k_sdf_repair,  spirv::k_sdf_sample};
+      spirv::k_sdf_transform,   spirv::k_sdf_cluster,  spirv::k_sdf_splat,  spirv::k_sdf_jfa,
+      spirv::k_sdf_flood_group, spirv::k_sdf_finalize, spirv::k_sdf_repair, spirv::k_sdf_sample};
+  // The one-group flood has a fixed work-group size (and 16 KB of shared memory, which every
+  // device has); a device with smaller groups floods step by step at every grid size.
+  const bool groupFlood = limits.maxComputeWorkGroupSize[0] >= L::kFloodGroupThreads &&
+                          limits.maxComputeWorkGroupInvocations >= L::kFloodGroupThreads;
   const VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};  // constant_id 0: local_size_x
   const uint32_t groupSize = b->workGroupSize_;
   const VkSpecializationInfo spec{1, &entry, sizeof(uint32_t), &groupSize};
   for (uint32_t p = 0; p < kPassCount; ++p) {
+    if (p == kFloodGroup && !groupFlood) continue;
     auto moduleInfo =
         vkStruct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
     moduleInfo.codeSize = code[p].size_bytes();

@@ -117,8 +117,10 @@ class VkSdfBuilder {
   const SdfGrid* grid() const { return gridValid_ ? &grid_ : nullptr; }
 
   // With VkSdfOptions::profile and a device that has timestamps: milliseconds of the last
-  // build's passes, in order transform, hierarchy, splat, flood, finalize, sample. Empty
-  // otherwise.
+  // build's passes, in order transform, hierarchy, splat, flood, finalize, sample. Grids of up
+  // to 4096 nodes flood in one work group; signed by pseudo-normals, that one dispatch also
+  // finalizes and samples, so its time is the flood's and finalize and sample read about 0.
+  // Empty otherwise.
   std::span<const double> passTimesMs() const { return passTimesMs_; }
 
   bool failed() const { return failed_; }

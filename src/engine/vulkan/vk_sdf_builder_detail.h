@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -24,13 +25,26 @@ enum Pass : uint32_t {
   kCluster,
   kSplat,
   kJfa,
+  kFloodGroup,  // grids of up to L::kFloodGroupNodes nodes; none when the device is too small
   kFinalize,
   kRepair,
   kSample,
   kPassCount
 };
 // Timestamps: start, then after transform, hierarchy, splat, flood, finalize (+ repair), sample.
+// On the one-group path with pseudo-normal signs the flood's dispatch also finalizes and samples:
+// the last two stamps follow it at once.
 constexpr uint32_t kTimestampCount = 7;
+
+// Tests only: which flood the builds take.
+struct FloodTestHooks {
+  // When set, every build floods with one dispatch per step (sdf_jfa.comp), as grids over
+  // L::kFloodGroupNodes nodes do, so the one-group path can be compared with it.
+  std::atomic<bool> forceStepwise{false};
+  // Builds recorded with the one-group flood (shaders/sdf_flood_group.comp).
+  std::atomic<uint32_t> groupFloods{0};
+};
+extern FloodTestHooks floodTestHooks;
 
 // Buffers the builder owns, by role.
 enum Slot : uint32_t {
@@ -40,7 +54,7 @@ enum Slot : uint32_t {
   kStaging,     // host copy of positions, indices, pseudo-normals; copied by the next build
   kTris,        // triangles in box space
   kNodes,       // winding-number hierarchy
-  kDistBits,    // splat minimum per node
+  kDistBits,    // splat minimum per node; then unrepaired values (pseudo-normals, stepwise flood)
   kIdsA,        // closest-triangle ids, ping
   kIdsB,        // closest-triangle ids, pong
   kValues,      // the SDF (device side)

@@ -14,6 +14,12 @@ namespace sdfg::vk_layout {
 inline constexpr uint32_t kFanOut = 32;    // children per winding-hierarchy node
 inline constexpr uint32_t kMaxLevels = 5;  // levels the shaders address (levelOffset0..4)
 inline constexpr uint32_t kNoTriangle = 0xffffffffu;
+// shaders/sdf_flood_group.comp: one work group of this many invocations, each with 4 nodes, so
+// grids of up to kFloodGroupNodes nodes (16^3) flood in shared memory (16 KB of ids).
+inline constexpr uint32_t kFloodGroupThreads = 1024;
+inline constexpr uint32_t kFloodGroupNodes = 4 * kFloodGroupThreads;
+// shaders/sdf_splat.comp: invocations per triangle (log2), each taking every 4th z layer.
+inline constexpr uint32_t kSplatSplitLog2 = 2;
 
 // Binding 0 (std430, read-only storage buffer): per-build parameters. See BuildParams in
 // sdf_common.glsl.
@@ -79,7 +85,7 @@ static_assert(sizeof(TrianglePseudoNormals) == 96);
 // Push constants shared by every pass (each reads the members it declares).
 struct PushConstants {
   uint32_t a = 0;  // cluster: level; splat: mode; jfa/finalize: step
-  uint32_t b = 0;  // jfa/finalize: flip
+  uint32_t b = 0;  // splat: log2 of invocations per triangle; jfa/finalize: flip
 };
 static_assert(sizeof(PushConstants) == 8);
 

@@ -9,6 +9,8 @@
 
 namespace sdfg::vk_sdf_detail {
 
+FloodTestHooks floodTestHooks;
+
 // Spreads the low 10 bits of v to every third bit (Morton order of triangle centroids, so that
 // consecutive triangles, the hierarchy's clusters, are close in space).
 uint32_t spreadBits(uint32_t v) {

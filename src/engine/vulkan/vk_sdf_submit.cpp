@@ -154,6 +154,12 @@ Status VkSdfBuilder::record(bool build, size_t pointCount, bool readBack) {
   stamp(0);
 
   const size_t nodeCount = box_.nodeCount();
+  // Small grids flood in one work group; with pseudo-normal signs that dispatch also finalizes,
+  // repairs and samples (fusedFinal).
+  const bool groupFlood = build && o.pipelines[kFloodGroup] && nodeCount <= L::kFloodGroupNodes &&
+                          !floodTestHooks.forceStepwise.load(std::memory_order_relaxed);
+  const bool fusedFinal = groupFlood && pseudoNormalSign_;
+  if (groupFlood) floodTestHooks.groupFloods.fetch_add(1, std::memory_order_relaxed);
   if (build) {
     if (uploadPending_) {
       const VkDeviceSize posBytes = VkDeviceSize(vertexCount_) * 12;
@@ -178,13 +184,10 @@ Status VkSdfBuilder::record(bool build, size_t pointCount, bool readBack) {
       barrier(VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
               VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, kCompute, kRead);
     }
-    fn.vkCmdFillBuffer(cmd, o.buffers[kDistBits].buffer.get(), 0, nodeCount * 4, 0x7f800000u);
-    fn.vkCmdFillBuffer(cmd, o.buffers[kIdsA].buffer.get(), 0, nodeCount * 4, L::kNoTriangle);
-    // The clears (+inf distances, no triangle) must land before the splat's atomics and writes.
-    barrier(kTransfer, VK_ACCESS_TRANSFER_WRITE_BIT, kCompute, kRead | kWrite);
-
-    dispatch(kTransform, triangleCount_, {});
-    // Box-space triangles are written before the hierarchy and splat passes read them.
+    // The transform pass also clears the splat's per-node minimum and ids (see its shader).
+    dispatch(kTransform, std::max<size_t>(triangleCount_, nodeCount), {});
+    // Box-space triangles and the cleared nodes are written before the hierarchy and splat
+    // passes read them.
     computeToCompute();
     stamp(1);
     // The hierarchy serves only the winding number.
@@ -195,34 +198,63 @@ Status VkSdfBuilder::record(bool build, size_t pointCount, bool readBack) {
       computeToCompute();
     }
     stamp(2);
-    dispatch(kSplat, triangleCount_, {0, 0});
+    // Several invocations per triangle, unless that many exceed the device's group count.
+    const uint32_t maxGroups = ctx_->properties().limits.maxComputeWorkGroupCount[0];
+    const uint32_t split =
+        ceilDiv(size_t(triangleCount_) << L::kSplatSplitLog2, workGroupSize_) <= maxGroups
+            ? L::kSplatSplitLog2
+            : 0;
+    const size_t splatItems = size_t(triangleCount_) << split;
+    dispatch(kSplat, splatItems, {0, split});
     // Every atomic minimum must be done before mode 1 compares against the minimum.
     computeToCompute();
-    dispatch(kSplat, triangleCount_, {1, 0});
+    dispatch(kSplat, splatItems, {1, split});
     // Seed ids are written before the first flood step reads them.
     computeToCompute();
     stamp(3);
-    uint32_t flip = 0;
-    for (uint32_t step :
-         jumpSteps(std::max({box_.resolution.x, box_.resolution.y, box_.resolution.z}))) {
-      dispatch(kJfa, nodeCount, {step, flip});
-      // This step's ids are written before the next step (or the final pass) reads them, and
-      // the next step overwrites the buffer this one read.
-      computeToCompute();
-      flip ^= 1u;
+    if (groupFlood) {
+      // One work group floods in shared memory (shaders/sdf_flood_group.comp); with
+      // pseudo-normals it also writes the values and samples the points.
+      fn.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, o.pipelines[kFloodGroup].get());
+      fn.vkCmdDispatch(cmd, 1, 1, 1);
+      if (!fusedFinal) {
+        // The final ids (binding 7) are written before the final pass reads them.
+        computeToCompute();
+        stamp(4);
+        dispatch(kFinalize, nodeCount, {0, 1});
+      }
+    } else {
+      uint32_t flip = 0;
+      for (uint32_t step :
+           jumpSteps(std::max({box_.resolution.x, box_.resolution.y, box_.resolution.z}))) {
+        dispatch(kJfa, nodeCount, {step, flip});
+        // This step's ids are written before the next step (or the final pass) reads them, and
+        // the next step overwrites the buffer this one read.
+        computeToCompute();
+        flip ^= 1u;
+      }
+      stamp(4);
+      dispatch(kFinalize, nodeCount, {0, flip});
+      if (pseudoNormalSign_) {
+        // The unrepaired values are written before the repair pass reads them.
+        computeToCompute();
+        dispatch(kRepair, nodeCount, {});
+      }
     }
-    stamp(4);
-    dispatch(kFinalize, nodeCount, {0, flip});
-    if (pseudoNormalSign_) {
-      // The unrepaired values are written before the repair pass reads them.
-      computeToCompute();
-      dispatch(kRepair, nodeCount, {});
+    if (fusedFinal) {
+      stamp(4);
+      stamp(5);
+      // The values and samples are written before the host copy, the host and a later
+      // submitSample() read them.
+      barrier(kCompute, kWrite, kCompute | kTransfer | VK_PIPELINE_STAGE_HOST_BIT,
+              kRead | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_HOST_READ_BIT);
+    } else {
+      // The SDF is written before sampling and the host copy read it.
+      barrier(kCompute, kWrite, kCompute | kTransfer, kRead | VK_ACCESS_TRANSFER_READ_BIT);
+      stamp(5);
     }
-    // The SDF is written before sampling and the host copy read it.
-    barrier(kCompute, kWrite, kCompute | kTransfer, kRead | VK_ACCESS_TRANSFER_READ_BIT);
-    stamp(5);
   }
-  if (pointCount > 0) {
+  if (pointCount > 0 && !fusedFinal) {
     dispatch(kSample, pointCount, {});
     // Sampled values are written before the host reads them after the fence.
     barrier(kCompute, kWrite, VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);

@@ -39,29 +39,6 @@ OpenPalm openPalmInLocal(const XrPosef& grip) {
           glm::normalize(localFromWrist.transformVector(across)), localFromWrist};
 }
 
-// Smallest clearance of the located hand's surface model: the palm's sphere and every capsule
-// between consecutive joints of each finger, metacarpal to tip. Negative inside.
-float wholeHandClearance(const Joints& j, const std::function<float(const XrVector3f&)>& distance) {
-  const XrHandJointLocationEXT& palm = j.joints[XR_HAND_JOINT_PALM_EXT];
-  float best = distance(palm.pose.position) - palm.radius;
-  for (int f = 0; f < 5; ++f) {
-    const int first = f == 0 ? XR_HAND_JOINT_THUMB_METACARPAL_EXT : kTips[f] - 4;
-    for (int k = first; k < kTips[f]; ++k) {
-      const XrHandJointLocationEXT& a = j.joints[k];
-      const XrHandJointLocationEXT& b = j.joints[k + 1];
-      constexpr int kSteps = 16;
-      for (int s = 0; s <= kSteps; ++s) {
-        const float t = float(s) / kSteps;
-        const XrVector3f p{a.pose.position.x + t * (b.pose.position.x - a.pose.position.x),
-                           a.pose.position.y + t * (b.pose.position.y - a.pose.position.y),
-                           a.pose.position.z + t * (b.pose.position.z - a.pose.position.z)};
-        best = std::min(best, distance(p) - (a.radius + t * (b.radius - a.radius)));
-      }
-    }
-  }
-  return best;
-}
-
 struct Reading {
   Joints joints;
   XrGraspStateSDFG state{XR_TYPE_GRASP_STATE_SDFG};

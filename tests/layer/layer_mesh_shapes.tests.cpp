@@ -388,27 +388,6 @@ float fingerGap(const Joints& j, int finger, const Distance& distance) {
   return best;
 }
 
-// Smallest clearance of the whole located hand: the palm's sphere and every capsule between
-// consecutive joints, metacarpal to tip (as layer_clearance.tests.cpp). Negative inside.
-float wholeHandClearance(const Joints& j, const Distance& distance) {
-  const XrHandJointLocationEXT& palm = j.joints[XR_HAND_JOINT_PALM_EXT];
-  float best = distance(palm.pose.position) - palm.radius;
-  for (int f = 0; f < 5; ++f) {
-    const int first = f == 0 ? XR_HAND_JOINT_THUMB_METACARPAL_EXT : kTips[f] - 4;
-    for (int k = first; k < kTips[f]; ++k) {
-      const XrHandJointLocationEXT& a = j.joints[k];
-      const XrHandJointLocationEXT& b = j.joints[k + 1];
-      constexpr int kSteps = 16;
-      for (int s = 0; s <= kSteps; ++s) {
-        const float t = float(s) / kSteps;
-        const glm::vec3 p = glm::mix(vec(a.pose.position), vec(b.pose.position), t);
-        best = std::min(best, distance(xr(p)) - (a.radius + t * (b.radius - a.radius)));
-      }
-    }
-  }
-  return best;
-}
-
 // What one grab ended with.
 struct Grab {
   bool grasped = false;  // isGrasping with the hand's offset blended in fully, within the bound

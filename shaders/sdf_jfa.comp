@@ -6,8 +6,9 @@
 // their triangles, the one at the smallest exact distance from itself. Distances are always
 // exact point-triangle distances, so a propagated id can only make a node's value larger than
 // the true distance when the flood missed the true closest triangle.
-// Grids of up to 4096 nodes flood in one work group instead (sdf_flood_group.comp), with the
-// same result.
+// The builder takes this pass on CPU devices (lavapipe) for grids over 4096 nodes; smaller grids
+// there flood in one work group (sdf_flood_group.comp), and GPUs take sdf_jfa_wide.comp, a lane
+// per neighbour: all three give the same ids, bit for bit (tests/unit/vk_sdf.tests.cpp).
 #include "sdf_common.glsl"
 
 // Bindings 6 and 7: ping-pong id buffers; pc.flip picks the direction.

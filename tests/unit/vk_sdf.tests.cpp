@@ -361,12 +361,14 @@ TEST_CASE("Vulkan sampling equals CPU trilinear sampling of the same grid", "[gp
 
 namespace {
 
+using vk_sdf_detail::FloodPath;
+
 // Sets the builder's flood for the scope (vk_sdf_detail::floodTestHooks) and restores it after.
-struct StepwiseFlood {
-  explicit StepwiseFlood(bool on) { vk_sdf_detail::floodTestHooks.forceStepwise = on; }
-  ~StepwiseFlood() { vk_sdf_detail::floodTestHooks.forceStepwise = false; }
-  StepwiseFlood(const StepwiseFlood&) = delete;
-  StepwiseFlood& operator=(const StepwiseFlood&) = delete;
+struct ForcedFlood {
+  explicit ForcedFlood(FloodPath path) { vk_sdf_detail::floodTestHooks.force = path; }
+  ~ForcedFlood() { vk_sdf_detail::floodTestHooks.force = FloodPath::automatic; }
+  ForcedFlood(const ForcedFlood&) = delete;
+  ForcedFlood& operator=(const ForcedFlood&) = delete;
 };
 
 struct BuildResult {
@@ -375,8 +377,8 @@ struct BuildResult {
 };
 
 BuildResult buildAndSample(VkSdfBuilder& b, const GridBox& box, std::span<const glm::vec3> points,
-                           bool stepwise) {
-  const StepwiseFlood flood(stepwise);
+                           FloodPath path) {
+  const ForcedFlood flood(path);
   REQUIRE(b.submitBuild(box, testObjectFromHand(), points, true) == Status::ok);
   REQUIRE(b.wait(600'000'000'000ull) == SdfPoll::ready);
   REQUIRE(b.grid() != nullptr);
@@ -390,10 +392,11 @@ size_t bitDifferences(std::span<const float> x, std::span<const float> y) {
   return n;
 }
 
-// The one-group flood (grids up to 4096 nodes, shaders/sdf_flood_group.comp) against the
-// stepwise flood of larger grids on the same mesh and box: every node value and every sample
-// equal bit for bit (the same steps, candidates and comparisons), the samples also equal to the
-// CPU's trilinear sampling of the read-back grid, and no validation message.
+// The floods against each other on the same mesh and box: the one-group flood (grids up to 4096
+// nodes, shaders/sdf_flood_group.comp), the per-node stepwise flood (sdf_jfa.comp) and the wide
+// stepwise flood (sdf_jfa_wide.comp), each forced, and the device's own choice: every node value
+// and every sample equal bit for bit (the same steps, candidates and comparisons), the samples
+// also equal to the CPU's trilinear sampling of the read-back grid, and no validation message.
 void checkFloodPaths(const std::string& name, const TriangleMesh& mesh) {
   REQUIRE_DEVICE(vk);
   auto builder = VkSdfBuilder::create(vk->device());
@@ -404,34 +407,55 @@ void checkFloodPaths(const std::string& name, const TriangleMesh& mesh) {
   std::uniform_real_distribution<float> u(-0.1f, 1.1f);
   std::vector<glm::vec3> points;
   for (int i = 0; i < 3000; ++i) points.emplace_back(u(rng), u(rng), u(rng));
+  const bool cpuDevice = b.context().properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  auto& hooks = vk_sdf_detail::floodTestHooks;
   // 16^3, and the largest grids on either side of the one-group limit.
   for (const glm::uvec3 res : {glm::uvec3(16), glm::uvec3(20, 10, 20), glm::uvec3(17, 16, 16)}) {
     CAPTURE(name, res.x, res.y, res.z);
     GridBox box = testBox(16);
     box.resolution = res;
-    const bool group = box.nodeCount() <= 4096;
-    const uint32_t before = vk_sdf_detail::floodTestHooks.groupFloods;
-    const BuildResult fast = buildAndSample(b, box, points, false);
-    CHECK(vk_sdf_detail::floodTestHooks.groupFloods - before == (group ? 1u : 0u));
-    const BuildResult stepwise = buildAndSample(b, box, points, true);
-    CHECK(vk_sdf_detail::floodTestHooks.groupFloods - before == (group ? 1u : 0u));
-    CHECK(bitDifferences(fast.grid.values(), stepwise.grid.values()) == 0);
-    CHECK(bitDifferences(fast.samples, stepwise.samples) == 0);
+    const bool fits = box.nodeCount() <= 4096;
+    uint32_t groups = hooks.groupFloods, wides = hooks.wideFloods;
+    const BuildResult group = buildAndSample(b, box, points, FloodPath::group);
+    // Too large for one group: the device's stepwise flood instead.
+    CHECK(hooks.groupFloods - groups == (fits ? 1u : 0u));
+    CHECK(hooks.wideFloods - wides == (fits || cpuDevice ? 0u : 1u));
+    groups = hooks.groupFloods, wides = hooks.wideFloods;
+    const BuildResult perNode = buildAndSample(b, box, points, FloodPath::perNode);
+    const BuildResult wide = buildAndSample(b, box, points, FloodPath::wide);
+    CHECK(hooks.groupFloods == groups);
+    CHECK(hooks.wideFloods - wides == 1u);
+    groups = hooks.groupFloods, wides = hooks.wideFloods;
+    const BuildResult automatic = buildAndSample(b, box, points, FloodPath::automatic);
+    // CPU devices: the one-group flood where it fits; GPUs: the wide flood.
+    CHECK(hooks.groupFloods - groups == (cpuDevice && fits ? 1u : 0u));
+    CHECK(hooks.wideFloods - wides == (cpuDevice ? 0u : 1u));
+    for (const BuildResult* other : {&perNode, &wide, &automatic}) {
+      CHECK(bitDifferences(group.grid.values(), other->grid.values()) == 0);
+      CHECK(bitDifferences(group.samples, other->samples) == 0);
+    }
     size_t mismatches = 0;
     for (size_t i = 0; i < points.size(); ++i) {
-      const float cpu = fast.grid.sampleNormalized(points[i]);
-      if (std::abs(fast.samples[i] - cpu) > 1e-6f * std::max(1.0f, std::abs(cpu))) ++mismatches;
+      const float cpu = automatic.grid.sampleNormalized(points[i]);
+      if (std::abs(automatic.samples[i] - cpu) > 1e-6f * std::max(1.0f, std::abs(cpu))) {
+        ++mismatches;
+      }
     }
     CHECK(mismatches == 0);
     // The grid sampled again with no rebuild (sdf_sample.comp on the values the flood wrote).
     REQUIRE(b.submitSample(points) == Status::ok);
     REQUIRE(b.wait(600'000'000'000ull) == SdfPoll::ready);
-    CHECK(bitDifferences(b.samples(), fast.samples) == 0);
+    CHECK(bitDifferences(b.samples(), automatic.samples) == 0);
   }
-  // 32^3 floods step by step.
-  const uint32_t before = vk_sdf_detail::floodTestHooks.groupFloods;
-  buildAndSample(b, testBox(32), points, false);
-  CHECK(vk_sdf_detail::floodTestHooks.groupFloods == before);
+  // 32^3 floods step by step, per node on a CPU device, wide on a GPU; the two agree.
+  const uint32_t groups = hooks.groupFloods, wides = hooks.wideFloods;
+  const BuildResult automatic = buildAndSample(b, testBox(32), points, FloodPath::automatic);
+  CHECK(hooks.groupFloods == groups);
+  CHECK(hooks.wideFloods - wides == (cpuDevice ? 0u : 1u));
+  const BuildResult other =
+      buildAndSample(b, testBox(32), points, cpuDevice ? FloodPath::wide : FloodPath::perNode);
+  CHECK(bitDifferences(automatic.grid.values(), other.grid.values()) == 0);
+  CHECK(bitDifferences(automatic.samples, other.samples) == 0);
   CHECK(vk->messageCount() == 0);
 }
 

@@ -42,7 +42,7 @@ using Clock = std::chrono::steady_clock;
 const char* const kUsage =
     "usage: autograsp-sdf-scaling [--meshes DIR] [--runs N] [--res 16,32,64] [--quick]\n"
     "                             [--profile] [--wg N] [--only torus|meshes] [--far-band M]\n"
-    "                             [--stepwise-flood]\n"
+    "                             [--flood group|node|wide]\n"
     "  --meshes DIR       folder of the test meshes (default ../shared/meshes)\n"
     "  --runs N           timed runs per row after one warm-up; the median is shown (default 5)\n"
     "  --res LIST         comma-separated grid resolutions, 2..128 (default 16,32,64)\n"
@@ -53,10 +53,12 @@ const char* const kUsage =
     "  --only torus|meshes  keep one group of rows\n"
     "  --far-band M       CPU builder far-field mode: CpuSdfOptions::exactBand = M metres\n"
     "                     (default 0, exact everywhere)\n"
-    "  --stepwise-flood   Vulkan: flood every grid with one dispatch per jump step, as grids\n"
-    "                     over 4096 nodes do, instead of small grids' one-group flood (which\n"
-    "                     also finalizes and samples: its pass times show final and sample as\n"
-    "                     0, counted in flood)\n"
+    "  --flood PATH       Vulkan: force the flood; group: one work group for grids of up to\n"
+    "                     4096 nodes (also finalizes and samples: its pass times show final\n"
+    "                     and sample as 0, counted in flood; the default on CPU devices);\n"
+    "                     node: one dispatch per jump step, one invocation per node (CPU\n"
+    "                     devices' larger grids); wide: one dispatch per jump step, a lane per\n"
+    "                     neighbour (the default on GPUs)\n"
     "  --help             this text\n"
     "exit codes: 0 done; 1 the CPU builder failed; 2 bad option\n";
 
@@ -89,17 +91,26 @@ int main(int argc, char** argv) {
       "a distance >= 0 in metres");
   app.add_flag("--profile", builderOptions.vulkanProfile);
   app.add_flag("--quick", quick);
-  bool stepwiseFlood = false;
-  app.add_flag("--stepwise-flood", stepwiseFlood);
+  std::string flood;
+  app.add_option("--flood", flood);
   std::vector<long long> res;
   cli::addIntegerList(app, "--res", kMinGridResolution, kMaxGridResolution, "resolution", res);
   if (auto exit = cli::parseOrUsage(app, argc, argv, "autograsp-sdf-scaling", kUsage)) return *exit;
   if (!meshes.empty()) meshDir = meshes;
-  if (stepwiseFlood) {
+  if (!flood.empty()) {
 #ifdef SDFG_SCALING_VULKAN
-    vk_sdf_detail::floodTestHooks.forceStepwise = true;
+    using vk_sdf_detail::FloodPath;
+    const FloodPath path = flood == "group"  ? FloodPath::group
+                           : flood == "node" ? FloodPath::perNode
+                           : flood == "wide" ? FloodPath::wide
+                                             : FloodPath::automatic;
+    if (path == FloodPath::automatic) {
+      std::fprintf(stderr, "--flood: group, node or wide, not %s\n", flood.c_str());
+      return 2;
+    }
+    vk_sdf_detail::floodTestHooks.force = path;
 #else
-    std::fprintf(stderr, "--stepwise-flood: built without the Vulkan builder\n");
+    std::fprintf(stderr, "--flood: built without the Vulkan builder\n");
     return 2;
 #endif
   }

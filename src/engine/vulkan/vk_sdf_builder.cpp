@@ -76,8 +76,9 @@ Result<std::unique_ptr<VkSdfBuilder>> VkSdfBuilder::create(const VulkanDevice& d
   o.pipelineLayout = VkOwned<VkPipelineLayout>(c, pipelineLayout);
 
   const std::array<std::span<const uint32_t>, kPassCount> code = {
-      spirv::k_sdf_transform,   spirv::k_sdf_cluster,  spirv::k_sdf_splat,  spirv::k_sdf_jfa,
-      spirv::k_sdf_flood_group, spirv::k_sdf_finalize, spirv::k_sdf_repair, spirv::k_sdf_sample};
+      spirv::k_sdf_transform, spirv::k_sdf_cluster,  spirv::k_sdf_splat,
+      spirv::k_sdf_jfa,       spirv::k_sdf_jfa_wide, spirv::k_sdf_flood_group,
+      spirv::k_sdf_finalize,  spirv::k_sdf_repair,   spirv::k_sdf_sample};
   // The one-group flood has a fixed work-group size (and 16 KB of shared memory, which every
   // device has); a device with smaller groups floods step by step at every grid size.
   const bool groupFlood = limits.maxComputeWorkGroupSize[0] >= L::kFloodGroupThreads &&

@@ -24,7 +24,8 @@ enum Pass : uint32_t {
   kTransform,
   kCluster,
   kSplat,
-  kJfa,
+  kJfa,         // one invocation per node and step: CPU devices' grids over L::kFloodGroupNodes
+  kJfaWide,     // L::kWideFloodNodesPerGroup nodes per work group, a lane per neighbour: GPUs
   kFloodGroup,  // grids of up to L::kFloodGroupNodes nodes; none when the device is too small
   kFinalize,
   kRepair,
@@ -36,13 +37,25 @@ enum Pass : uint32_t {
 // the last two stamps follow it at once.
 constexpr uint32_t kTimestampCount = 7;
 
-// Tests only: which flood the builds take.
+// Which flood a build takes (record() in vk_sdf_submit.cpp). All three give the same ids, bit for
+// bit: the same steps, candidates, order and comparisons.
+enum class FloodPath : uint32_t {
+  automatic,  // the device's choice: see record()
+  group,      // one work group in shared memory (sdf_flood_group.comp), grids up to 4096 nodes
+  perNode,    // one dispatch per step, one invocation per node (sdf_jfa.comp)
+  wide,       // one dispatch per step, one lane per neighbour (sdf_jfa_wide.comp)
+};
+
+// Tests and tools only: which flood the builds take.
 struct FloodTestHooks {
-  // When set, every build floods with one dispatch per step (sdf_jfa.comp), as grids over
-  // L::kFloodGroupNodes nodes do, so the one-group path can be compared with it.
-  std::atomic<bool> forceStepwise{false};
+  // When not automatic, every build floods this way where it can (the group flood only up to
+  // L::kFloodGroupNodes nodes; larger grids then take the device's step-by-step flood), so the
+  // paths can be compared on one device.
+  std::atomic<FloodPath> force{FloodPath::automatic};
   // Builds recorded with the one-group flood (shaders/sdf_flood_group.comp).
   std::atomic<uint32_t> groupFloods{0};
+  // Builds recorded with the wide step-by-step flood (shaders/sdf_jfa_wide.comp).
+  std::atomic<uint32_t> wideFloods{0};
 };
 extern FloodTestHooks floodTestHooks;
 

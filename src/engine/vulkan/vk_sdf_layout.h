@@ -18,6 +18,10 @@ inline constexpr uint32_t kNoTriangle = 0xffffffffu;
 // grids of up to kFloodGroupNodes nodes (16^3) flood in shared memory (16 KB of ids).
 inline constexpr uint32_t kFloodGroupThreads = 1024;
 inline constexpr uint32_t kFloodGroupNodes = 4 * kFloodGroupThreads;
+// Mirrored by shaders/sdf_jfa_wide.comp: its fixed work-group size, 32 lanes per node (27
+// neighbours, the rest idle).
+inline constexpr uint32_t kWideFloodThreads = 64;
+inline constexpr uint32_t kWideFloodNodesPerGroup = kWideFloodThreads / 32;
 // shaders/sdf_splat.comp: invocations per triangle (log2), each taking every 4th z layer.
 inline constexpr uint32_t kSplatSplitLog2 = 2;
 

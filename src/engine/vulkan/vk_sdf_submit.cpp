@@ -159,15 +159,21 @@ Status VkSdfBuilder::record(bool build, size_t pointCount, bool readBack) {
   // nodes flood in one work group, which halves build times there; with pseudo-normal signs that
   // dispatch also finalizes, repairs and samples (fusedFinal). On a GPU one multiprocessor doing
   // all the work is slower than the whole device step by step (NVIDIA H200, 16^3 grid, 100k
-  // triangles: 0.41 ms against 0.09 ms), so every other device type floods step by step, with a
-  // lane per neighbour (sdf_jfa_wide.comp: one invocation per node left 64 groups of 64 waiting
-  // on 26 serial triangle distances, ~15 us a step). Larger grids on a CPU take sdf_jfa.comp,
-  // one invocation per node, whose early outs save work a CPU would otherwise do.
+  // triangles: 0.41 ms against 0.09 ms), so every other device type floods step by step. Small
+  // grids there take a lane per neighbour (sdf_jfa_wide.comp: one invocation per node left 64
+  // groups of 64 waiting on 26 serial triangle distances; 0.05 ms against 0.09 on the H200 at
+  // 16^3); larger ones fill the device with one invocation per node, whose early outs then save
+  // more than the lanes gain (H200 at 32^3: 0.12 ms per node against 0.26 wide; at 64^3 0.4
+  // against 2.2). Larger grids on a CPU take sdf_jfa.comp too.
   const bool cpuDevice = ctx_->properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   const bool groupFits = o.pipelines[kFloodGroup] && nodeCount <= L::kFloodGroupNodes;
   const bool wideFits = ceilDiv(nodeCount, L::kWideFloodNodesPerGroup) <= maxGroups;
   FloodPath flood = floodTestHooks.force.load(std::memory_order_relaxed);
-  if (flood == FloodPath::automatic) flood = cpuDevice ? FloodPath::group : FloodPath::wide;
+  if (flood == FloodPath::automatic) {
+    flood = cpuDevice                          ? FloodPath::group
+            : nodeCount <= L::kFloodGroupNodes ? FloodPath::wide
+                                               : FloodPath::perNode;
+  }
   if (flood == FloodPath::group && !groupFits) {
     flood = cpuDevice ? FloodPath::perNode : FloodPath::wide;
   }

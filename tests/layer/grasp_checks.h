@@ -111,6 +111,21 @@ inline constexpr int kTips[5] = {XR_HAND_JOINT_THUMB_TIP_EXT, XR_HAND_JOINT_INDE
                                  XR_HAND_JOINT_MIDDLE_TIP_EXT, XR_HAND_JOINT_RING_TIP_EXT,
                                  XR_HAND_JOINT_LITTLE_TIP_EXT};
 
+// Clearance of the capsule between two located joints, radii interpolated between theirs, sampled
+// at `steps` + 1 points along it, against `distance` (negative inside).
+inline float capsuleClearance(const XrHandJointLocationEXT& a, const XrHandJointLocationEXT& b,
+                              int steps, const std::function<float(const XrVector3f&)>& distance) {
+  float best = std::numeric_limits<float>::infinity();
+  for (int s = 0; s <= steps; ++s) {
+    const float t = float(s) / float(steps);
+    const XrVector3f p{a.pose.position.x + t * (b.pose.position.x - a.pose.position.x),
+                       a.pose.position.y + t * (b.pose.position.y - a.pose.position.y),
+                       a.pose.position.z + t * (b.pose.position.z - a.pose.position.z)};
+    best = std::min(best, distance(p) - (a.radius + t * (b.radius - a.radius)));
+  }
+  return best;
+}
+
 // Smallest clearance of the located hand's surface model: the palm's sphere and every capsule
 // between consecutive joints of each finger, metacarpal to tip, against `distance` (negative
 // inside). Negative when any part is inside.
@@ -120,18 +135,8 @@ inline float wholeHandClearance(const Joints& j,
   float best = distance(palm.pose.position) - palm.radius;
   for (int f = 0; f < 5; ++f) {
     const int first = f == 0 ? XR_HAND_JOINT_THUMB_METACARPAL_EXT : kTips[f] - 4;
-    for (int k = first; k < kTips[f]; ++k) {
-      const XrHandJointLocationEXT& a = j.joints[k];
-      const XrHandJointLocationEXT& b = j.joints[k + 1];
-      constexpr int kSteps = 16;
-      for (int s = 0; s <= kSteps; ++s) {
-        const float t = float(s) / kSteps;
-        const XrVector3f p{a.pose.position.x + t * (b.pose.position.x - a.pose.position.x),
-                           a.pose.position.y + t * (b.pose.position.y - a.pose.position.y),
-                           a.pose.position.z + t * (b.pose.position.z - a.pose.position.z)};
-        best = std::min(best, distance(p) - (a.radius + t * (b.radius - a.radius)));
-      }
-    }
+    for (int k = first; k < kTips[f]; ++k)
+      best = std::min(best, capsuleClearance(j.joints[k], j.joints[k + 1], 16, distance));
   }
   return best;
 }
@@ -149,18 +154,9 @@ inline float fingerClearance(const GraspOutcome& out, int finger,
                              const std::function<float(const XrVector3f&)>& distance) {
   const int first = finger == 0 ? XR_HAND_JOINT_THUMB_PROXIMAL_EXT : kTips[finger] - 3;
   float best = std::numeric_limits<float>::infinity();
-  for (int j = first; j < kTips[finger]; ++j) {
-    const XrHandJointLocationEXT& a = out.joints.joints[j];
-    const XrHandJointLocationEXT& b = out.joints.joints[j + 1];
-    constexpr int kSteps = 8;
-    for (int s = 0; s <= kSteps; ++s) {
-      const float t = float(s) / kSteps;
-      const XrVector3f p{a.pose.position.x + t * (b.pose.position.x - a.pose.position.x),
-                         a.pose.position.y + t * (b.pose.position.y - a.pose.position.y),
-                         a.pose.position.z + t * (b.pose.position.z - a.pose.position.z)};
-      best = std::min(best, distance(p) - (a.radius + t * (b.radius - a.radius)));
-    }
-  }
+  for (int j = first; j < kTips[finger]; ++j)
+    best = std::min(best,
+                    capsuleClearance(out.joints.joints[j], out.joints.joints[j + 1], 8, distance));
   return best;
 }
 

@@ -375,16 +375,8 @@ float fingerGap(const Joints& j, int finger, const Distance& distance) {
   // its metacarpal bone (the ball of the thumb) is where it often does on a small object.
   const int first = finger == 0 ? XR_HAND_JOINT_THUMB_METACARPAL_EXT : kTips[finger] - 3;
   float best = std::numeric_limits<float>::infinity();
-  for (int k = first; k < kTips[finger]; ++k) {
-    const XrHandJointLocationEXT& a = j.joints[k];
-    const XrHandJointLocationEXT& b = j.joints[k + 1];
-    constexpr int kSteps = 16;
-    for (int s = 0; s <= kSteps; ++s) {
-      const float t = float(s) / kSteps;
-      const glm::vec3 p = glm::mix(vec(a.pose.position), vec(b.pose.position), t);
-      best = std::min(best, distance(xr(p)) - (a.radius + t * (b.radius - a.radius)));
-    }
-  }
+  for (int k = first; k < kTips[finger]; ++k)
+    best = std::min(best, capsuleClearance(j.joints[k], j.joints[k + 1], 16, distance));
   return best;
 }
 
@@ -608,6 +600,20 @@ std::vector<std::string> linesWith(const std::string& log, const std::string& ne
   return out;
 }
 
+// The indexed mesh grasped at `pose`, then its soup and its hard-edge split: each on the surface,
+// each the same grasp as the indexed one.
+void checkSplitsLikeIndexed(const TestMesh& indexed, const TestMesh& soup, const TestMesh& split,
+                            const XrPosef& pose, const Distance& distance) {
+  const Grab reference = grab(indexed, pose);
+  checkOnSurface(reference, distance, pose);
+  for (const auto& [name, mesh] : {std::pair{"soup", &soup}, std::pair{"hard edges", &split}}) {
+    INFO(name);
+    const Grab g = grab(*mesh, pose);
+    checkOnSurface(g, distance, pose);
+    checkSameAs(g, reference);
+  }
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -624,14 +630,7 @@ TEST_CASE("A box as a triangle soup or with hard-edge splits is grasped as the i
   const XrPosef pose = clearBelowPalm(exact);
   const Distance distance = placed(exact, pose);
 
-  const Grab reference = grab(indexed, pose);
-  checkOnSurface(reference, distance, pose);
-  for (const auto& [name, mesh] : {std::pair{"soup", &soup}, std::pair{"hard edges", &split}}) {
-    INFO(name);
-    const Grab g = grab(*mesh, pose);
-    checkOnSurface(g, distance, pose);
-    checkSameAs(g, reference);
-  }
+  checkSplitsLikeIndexed(indexed, soup, split, pose, distance);
 }
 
 TEST_CASE("The mug as a triangle soup or with hard-edge splits is grasped as the indexed mug",
@@ -643,14 +642,7 @@ TEST_CASE("The mug as a triangle soup or with hard-edge splits is grasped as the
   const XrPosef pose = mugUnderRightPalm(indexed, kGrip);
   const Distance distance = placed(exactSolid(indexed), pose);
 
-  const Grab reference = grab(indexed, pose);
-  checkOnSurface(reference, distance, pose);
-  for (const auto& [name, mesh] : {std::pair{"soup", &soup}, std::pair{"hard edges", &split}}) {
-    INFO(name);
-    const Grab g = grab(*mesh, pose);
-    checkOnSurface(g, distance, pose);
-    checkSameAs(g, reference);
-  }
+  checkSplitsLikeIndexed(indexed, soup, split, pose, distance);
 }
 
 TEST_CASE("An open hand 5 mm inside a soup box is moved out before closing, as for the indexed box",

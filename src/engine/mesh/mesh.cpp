@@ -110,8 +110,11 @@ void transformMesh(TriangleMesh& mesh, const Pose& pose, float scale) {
 }
 
 TriangleMesh normalizedToDiagonal(const TriangleMesh& mesh, float diagonal) {
+  return normalizedToDiagonal(mesh, diagonal, computeBounds(mesh.positions));
+}
+
+TriangleMesh normalizedToDiagonal(const TriangleMesh& mesh, float diagonal, const Aabb& box) {
   TriangleMesh out = mesh;
-  const Aabb box = computeBounds(mesh.positions);
   const float current = glm::length(box.extent());
   const float scale = current > 0.0f ? diagonal / current : 1.0f;
   const glm::vec3 centre = box.center();

@@ -63,5 +63,8 @@ void transformMesh(TriangleMesh& mesh, const Pose& pose, float scale = 1.0f);
 // Returns a copy scaled uniformly so the bounding-box diagonal equals `diagonal` metres and
 // centred on the origin (the benchmark scales every object to hand size this way).
 TriangleMesh normalizedToDiagonal(const TriangleMesh& mesh, float diagonal);
+// Same, with the scale and centre taken from `box` instead of the mesh's own bounds (a variant of
+// a mesh placed exactly as the original is).
+TriangleMesh normalizedToDiagonal(const TriangleMesh& mesh, float diagonal, const Aabb& box);
 
 }  // namespace sdfg

@@ -29,14 +29,7 @@ struct Graded {
 
 TriangleMesh normalizedLike(const TriangleMesh& mesh, const TriangleMesh& reference,
                             float diagonal) {
-  // normalizedToDiagonal()'s arithmetic, with the reference's bounds.
-  TriangleMesh out = mesh;
-  const Aabb box = computeBounds(reference.positions);
-  const float current = glm::length(box.extent());
-  const float scale = current > 0.0f ? diagonal / current : 1.0f;
-  const glm::vec3 centre = box.center();
-  for (glm::vec3& p : out.positions) p = (p - centre) * scale;
-  return out;
+  return normalizedToDiagonal(mesh, diagonal, computeBounds(reference.positions));
 }
 
 Result<QualityFigures> measureQuality(const TriangleMesh& given, const QualityRun& run) {

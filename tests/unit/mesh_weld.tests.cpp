@@ -185,3 +185,20 @@ TEST_CASE("A weld stopped by its limit leaves the indices as given", "[core][mes
   CHECK(r.stopped);
   CHECK(s.indices == given);
 }
+
+TEST_CASE("A weld that would leave a triangle of zero area changes nothing", "[core][mesh]") {
+  // Corner c of the sliver is within the tolerance of d, which a first triangle uses: welding c
+  // into d would lay a, b and c on one line.
+  TriangleMesh m;
+  m.positions = {{0.05f, 0.0f, 0.0f}, {0.05f, 0.05f, 0.0f}, {0.0f, 0.05f, 0.0f},
+                 {0.0f, 0.0f, 0.0f},  {0.1f, 0.0f, 0.0f},   {0.05f, 5e-7f, 0.0f}};
+  m.indices = {0, 1, 2, 3, 4, 5};
+  REQUIRE_FALSE(validateMesh(m.positions, m.indices).has_value());
+  const std::vector<uint32_t> given = m.indices;
+  const WeldReport r = weldByPosition(m.positions, m.indices);
+  CHECK_FALSE(r.stopped);
+  CHECK_FALSE(r.changed());
+  CHECK(r.vertices == 6);
+  CHECK(m.indices == given);
+  CHECK(distanceOf(m)->mesh().indices == given);
+}

@@ -409,17 +409,8 @@ void GraspWorker::runSetup(std::unique_lock<std::mutex>& lock, uint64_t id,
       // Game meshes split their vertices at seams and hard edges: the winding repair below and
       // every sign need the topology of the surface, not of the indices. The app's positions stay
       // as they are (its vertex updates apply one for one); only this copy of the indices
-      // changes. A weld that would leave a sliver of zero area is not taken.
-      std::vector<uint32_t> given = mesh.indices;
+      // changes.
       found.weld = weldByPosition(mesh.positions, mesh.indices, limit);
-      if (found.weld.changed() && !found.weld.stopped &&
-          validateMesh(mesh.positions, mesh.indices, limit)) {
-        mesh.indices = std::move(given);
-        const uint32_t used = found.weld.vertices;
-        found.weld = WeldReport{};
-        found.weld.vertices = found.weld.weldedVertices = used;
-      }
-      given = {};
       // Meshes come wound either way, or both: the SDF's sign needs outward triangles. An open
       // part's winding-number vote costs O(samples x triangles), so it runs here, not in the
       // app's create call.

@@ -381,12 +381,8 @@ Result<std::unique_ptr<MeshDistance>> MeshDistance::create(const TriangleMesh& m
   auto impl = std::make_unique<Impl>();
   impl->mesh = mesh;
   // The topology (shared edges, pseudo-normals, closedness) as the surface has it: split
-  // vertices welded, repeated triangles dropped (mesh_weld.h). A weld that would leave a
-  // triangle of zero area (a sliver thinner than the tolerance) is not taken.
-  const WeldReport weld = weldByPosition(impl->mesh.positions, impl->mesh.indices, limit);
-  if (weld.stopped) return stopped;
-  if (weld.changed() && validateMesh(impl->mesh.positions, impl->mesh.indices, limit))
-    impl->mesh.indices = mesh.indices;
+  // vertices welded, repeated triangles dropped (mesh_weld.h).
+  if (weldByPosition(impl->mesh.positions, impl->mesh.indices, limit).stopped) return stopped;
   if (!impl->bvh.build(impl->mesh.positions, impl->mesh.indices, 4, limit)) return stopped;
   if (!impl->buildTopology(limit) || !impl->computeNormals(limit)) return stopped;
   if (!impl->pseudoNormalSign) {

@@ -153,8 +153,14 @@ WeldReport weldByPosition(std::span<const glm::vec3> positions, std::vector<uint
     }
     welded.insert(welded.end(), corner.begin(), corner.end());
   }
-  if (welded.empty()) {
-    // Only possible for a mesh below the tolerance in every triangle: keep it as given.
+  // A welded corner moves by up to the tolerance: a sliver thinner than that could be left with no
+  // area, which no sign or normal can use. Such a mesh (or one below the tolerance in every
+  // triangle) is kept as given.
+  std::optional<Error> degenerate;
+  if (!welded.empty() && out.weldedVertices != out.vertices)
+    degenerate = findDegenerateTriangle(positions, welded, limit);
+  if (degenerate && degenerate->code == Status::timed_out) return stop();
+  if (welded.empty() || degenerate) {
     WeldReport unchanged;
     unchanged.vertices = unchanged.weldedVertices = out.vertices;
     return unchanged;

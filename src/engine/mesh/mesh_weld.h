@@ -57,8 +57,9 @@ struct WeldReport {
 
 // Rewrites `indices` (three per triangle into `positions`, valid as after validateMesh()) as
 // described above; the result is again a valid triangle list over the same positions, with at
-// least one triangle (if every triangle would collapse, nothing is changed and the report says
-// so through collapsedTriangles == 0 and weldedVertices == vertices). O(vertices + triangles)
+// least one triangle and none of zero area (a weld that would leave one, or no triangle at all,
+// changes nothing, and the report then says so: weldedVertices == vertices, nothing dropped).
+// O(vertices + triangles)
 // expected time, with `limit` polled every few thousand elements.
 WeldReport weldByPosition(std::span<const glm::vec3> positions, std::vector<uint32_t>& indices,
                           const WorkLimit& limit = WorkLimit::none());

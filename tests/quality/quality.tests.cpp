@@ -246,7 +246,10 @@ TEST_CASE("ours meets its published quality on the embedded thin plate with UV s
   checkEmbeddedVariant("thin-plate", "seams", kThinPlate);
 }
 
-// The research meshes, one case each for its three variants. Contacts per grasp: the original's
+// The research meshes up to 100k triangles, one case each for its three variants (the 400k
+// armadillo, the dragon and Igea took 220 s of the label's CPU time in all, a third of CI's budget
+// for it: their variants are in the benchmark, `autograsp-bench --variants`, and
+// docs/benchmarks-notes.md). Contacts per grasp: the original's
 // over the same first 100 placements (measured at 3c0ad0e; the 250-placement gates above do not
 // hold for a prefix: the bunny's first 100 give 4.66 against 4.75), less half a contact in 100
 // grasps so the comparison is not one of floats at an exact hundredth.
@@ -269,22 +272,6 @@ TEST_CASE("ours meets its published quality on the variants of the Stanford arma
           "[quality][shared][variants]") {
   SDFG_CHECK_SHARED_VARIANTS("stanford-armadillo-100k.obj",
                              (Gate{kSharedVariantPlacements, 4.425}));
-}
-
-TEST_CASE("ours meets its published quality on the variants of the Stanford armadillo (400k)",
-          "[quality][shared][variants]") {
-  SDFG_CHECK_SHARED_VARIANTS("stanford-armadillo-400k-subdiv.obj",
-                             (Gate{kSharedVariantPlacements, 4.415}));
-}
-
-TEST_CASE("ours meets its published quality on the variants of the Stanford dragon",
-          "[quality][shared][variants]") {
-  SDFG_CHECK_SHARED_VARIANTS("stanford-dragon-100k.ply", (Gate{kSharedVariantPlacements, 4.345}));
-}
-
-TEST_CASE("ours meets its published quality on the variants of the Igea scan (268k)",
-          "[quality][shared][variants]") {
-  SDFG_CHECK_SHARED_VARIANTS("igea-268k.obj", (Gate{kSharedVariantPlacements, 4.885}));
 }
 
 // Scenes (issue 26, eval/scene_quality.h): "ours" among other objects keeps the whole hand out of

@@ -1,5 +1,6 @@
 // DeferredMailbox: the owner's side never calls the device; pump() does, one pump at a time and
-// never waiting for another; exclusive() and shutdown() wait for a pump in progress.
+// never waiting for another; exclusive() and shutdown() wait for a pump in progress, at most their
+// bound; a device call that throws gives the device back.
 #include <catch2/catch.hpp>
 
 #include <array>
@@ -7,6 +8,8 @@
 #include <chrono>
 #include <future>
 #include <memory>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -30,15 +33,18 @@ class FakeDevice final : public DeferredSdfBackend {
     std::atomic<bool> gateClosed{false};
     std::atomic<bool> inReady{false};
     std::atomic<bool> failNext{false};
-    std::vector<std::thread::id> callers;  // written by the pumping thread only
+    std::atomic<bool> throwInReady{false};  // the next ready() throws
+    std::vector<glm::vec3> lastMesh;        // the positions of the last request with a mesh
+    std::vector<std::thread::id> callers;   // written by the pumping thread only
     std::vector<std::string> order;
   };
   explicit FakeDevice(std::shared_ptr<Log> log) : log_(std::move(log)) {}
   ~FakeDevice() override { log_->destroyed = true; }
   std::string_view name() const override { return "fake"; }
-  Status request(size_t slot, uint64_t id, uint64_t, const TriangleMesh*, const Pose&,
+  Status request(size_t slot, uint64_t id, uint64_t, const TriangleMesh* mesh, const Pose&,
                  const GridBox& box) override {
     note("request");
+    if (mesh != nullptr) log_->lastMesh = mesh->positions;
     if (log_->failNext) {
       failed_ = true;
       return Status::device_lost;
@@ -86,6 +92,7 @@ class FakeDevice final : public DeferredSdfBackend {
   bool ready() override {
     note("ready");
     ++log_->readyCalls;
+    if (log_->throwInReady.exchange(false)) throw std::runtime_error("the fake device threw");
     log_->inReady = true;
     while (log_->gateClosed) std::this_thread::sleep_for(1ms);
     log_->inReady = false;
@@ -113,12 +120,47 @@ struct Fixture {
   FakeDevice* device = nullptr;
   std::shared_ptr<DeferredMailbox> mailbox;
   std::unique_ptr<DeferredSdfBackend> owner;
-  Fixture() {
+  explicit Fixture(std::chrono::milliseconds claimWait = DeferredMailbox::kClaimWait) {
     auto d = std::make_unique<FakeDevice>(log);
     device = d.get();
-    mailbox = std::make_shared<DeferredMailbox>(std::move(d));
+    mailbox = std::make_shared<DeferredMailbox>(std::move(d), claimWait);
     owner = DeferredMailbox::ownerSide(mailbox);
   }
+  // Starts a pump on another thread and waits (bounded) until it is inside the device, held
+  // there until the gate opens.
+  std::future<bool> holdPump() {
+    log->gateClosed = true;
+    auto held = std::async(std::launch::async, [m = mailbox] { return m->pump(true); });
+    const auto deadline = std::chrono::steady_clock::now() + 20s;
+    while (!log->inReady && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(1ms);
+    REQUIRE(log->inReady);
+    return held;
+  }
+};
+
+// Runs `f` on a thread of its own and waits for it at most `bound` (generous: a loaded machine
+// under the sanitizers): its result, or nothing when it did not return. A call that never returns
+// is left behind (detached, with what `f` captured by value) so that the test fails instead of
+// hanging.
+template <class F>
+auto returnsWithin(std::chrono::seconds bound, F f) -> std::optional<decltype(f())> {
+  auto result = std::make_shared<std::promise<decltype(f())>>();
+  auto returned = result->get_future();
+  std::thread([result, call = std::optional<F>(std::move(f))]() mutable {
+    auto value = (*call)();
+    call.reset();  // what it captured goes before the caller hears of the result
+    result->set_value(std::move(value));
+  }).detach();
+  if (returned.wait_for(bound) != std::future_status::ready) return std::nullopt;
+  return returned.get();
+}
+
+// Opens the fake device's gate when the test leaves, also through a failed REQUIRE: a pump held
+// there would otherwise never end.
+struct GateOpener {
+  std::shared_ptr<FakeDevice::Log> log;
+  ~GateOpener() { log->gateClosed = false; }
 };
 
 const TriangleMesh& sphere() {
@@ -243,10 +285,134 @@ TEST_CASE("A device failure shows on the owner's side, and shutdown destroys the
   CHECK(f.owner->poll(0, grid) == BuildPoll::failed);
   CHECK(f.owner->request(0, 7, 1, &sphere(), Pose{}, GridBox::referenceDefault()) ==
         Status::device_lost);
-  f.mailbox->shutdown();
+  CHECK(f.mailbox->shutdown());
   CHECK(f.log->destroyed);
   CHECK_FALSE(f.mailbox->pump(true));
   bool ran = false;
-  f.mailbox->exclusive([&](DeferredSdfBackend&) { ran = true; });
+  CHECK(f.mailbox->exclusive([&](DeferredSdfBackend&) { ran = true; }) ==
+        DeferredMailbox::Access::shut_down);
   CHECK_FALSE(ran);
+}
+
+TEST_CASE(
+    "A device call that throws in a pump gives the device back, and what it did not reach "
+    "runs at the next pump",
+    "[core][deferred_mailbox]") {
+  Fixture f;
+  REQUIRE(f.mailbox->pump(false));
+  std::vector<std::string> seen;
+  std::vector<std::string> afterNextPump;
+  REQUIRE(f.owner->request(0, 7, 1, &sphere(), Pose{}, GridBox::referenceDefault()) == Status::ok);
+  SECTION("the device throws") {
+    f.mailbox->post([&](DeferredSdfBackend&) { seen.push_back("posted"); });
+    f.log->throwInReady = true;
+    CHECK_THROWS_AS(f.mailbox->pump(true), std::runtime_error);
+    CHECK(seen == std::vector<std::string>{"posted"});
+    afterNextPump = {"posted"};
+  }
+  SECTION("a posted call throws") {
+    f.mailbox->post([](DeferredSdfBackend&) { throw std::runtime_error("posted call threw"); });
+    f.mailbox->post([&](DeferredSdfBackend&) { seen.push_back("after it"); });
+    CHECK_THROWS_AS(f.mailbox->pump(true), std::runtime_error);
+    CHECK(seen.empty());
+    f.mailbox->post([&](DeferredSdfBackend&) { seen.push_back("posted later"); });
+    afterNextPump = {"after it", "posted later"};
+  }
+  CHECK(f.log->requests == 0);  // not reached: kept for the next pump
+  SdfGrid grid;
+  CHECK(f.owner->poll(0, grid) == BuildPoll::pending);
+  CHECK_FALSE(f.owner->failed());
+  // The next pump takes the device (it was given back) and does what the last one left.
+  REQUIRE(f.mailbox->pump(true));
+  CHECK(f.log->requests == 1);
+  CHECK(f.log->submits == 1);
+  CHECK(seen == afterNextPump);
+  bool ran = false;
+  CHECK(f.mailbox->exclusive([&](DeferredSdfBackend&) { ran = true; }) ==
+        DeferredMailbox::Access::done);
+  CHECK(ran);
+  const auto destroyedInTime = returnsWithin(60s, [m = f.mailbox] { return m->shutdown(); });
+  REQUIRE(destroyedInTime.has_value());
+  CHECK(*destroyedInTime);
+  CHECK(f.log->destroyed);
+}
+
+TEST_CASE("A call that throws in exclusive gives the device back", "[core][deferred_mailbox]") {
+  Fixture f;
+  std::vector<std::string> seen;
+  f.mailbox->post([](DeferredSdfBackend&) { throw std::runtime_error("posted call threw"); });
+  f.mailbox->post([&](DeferredSdfBackend&) { seen.push_back("after it"); });
+  CHECK_THROWS_AS(f.mailbox->exclusive([&](DeferredSdfBackend&) { seen.push_back("call"); }),
+                  std::runtime_error);
+  CHECK(seen.empty());
+  CHECK_THROWS_AS(f.mailbox->exclusive([](DeferredSdfBackend&) {
+    throw std::runtime_error("exclusive call threw");
+  }),
+                  std::runtime_error);
+  // The posted call after the one that threw ran before the call that threw next.
+  CHECK(seen == std::vector<std::string>{"after it"});
+  CHECK(f.mailbox->exclusive([&](DeferredSdfBackend&) { seen.push_back("call"); }) ==
+        DeferredMailbox::Access::done);
+  CHECK(seen == std::vector<std::string>{"after it", "call"});
+  CHECK(f.mailbox->pump(true));
+  const auto destroyedInTime = returnsWithin(60s, [m = f.mailbox] { return m->shutdown(); });
+  REQUIRE(destroyedInTime.has_value());
+  CHECK(*destroyedInTime);
+  CHECK(f.log->destroyed);
+}
+
+TEST_CASE("exclusive and shutdown stop waiting for a claim that outlasts their bound, and say so",
+          "[core][deferred_mailbox]") {
+  // A short bound keeps the test short; the outcome, not a time, is checked.
+  constexpr auto bound = 200ms;
+  Fixture f(bound);
+  auto held = f.holdPump();  // never ends while the gate is closed
+  const GateOpener opener{f.log};
+  auto ran = std::make_shared<std::atomic<bool>>(false);
+  const auto start = std::chrono::steady_clock::now();
+  const auto access = returnsWithin(60s, [m = f.mailbox, ran] {
+    return m->exclusive([ran](DeferredSdfBackend&) { *ran = true; });
+  });
+  REQUIRE(access.has_value());
+  CHECK(std::chrono::steady_clock::now() - start >= bound);
+  CHECK(*access == DeferredMailbox::Access::timed_out);
+  CHECK_FALSE(*ran);
+
+  const auto destroyedInTime = returnsWithin(60s, [m = f.mailbox] { return m->shutdown(); });
+  REQUIRE(destroyedInTime.has_value());
+  CHECK_FALSE(*destroyedInTime);
+  CHECK_FALSE(f.log->destroyed);  // the pump still uses it
+  CHECK(f.owner->failed());
+  CHECK(f.mailbox->exclusive([ran](DeferredSdfBackend&) { *ran = true; }) ==
+        DeferredMailbox::Access::shut_down);
+  CHECK_FALSE(*ran);
+
+  f.log->gateClosed = false;
+  CHECK(held.get());
+  CHECK_FALSE(f.mailbox->pump(true));
+  // The last reference frees the device the pump was using.
+  f.owner.reset();
+  f.mailbox.reset();
+  CHECK(f.log->destroyed);
+}
+
+TEST_CASE("A shared mesh is recorded without a copy and handed to the device at the pump",
+          "[core][deferred_mailbox]") {
+  Fixture f;
+  REQUIRE(f.mailbox->pump(false));
+  SharedMesh mesh;
+  mesh.positions = std::make_shared<const std::vector<glm::vec3>>(sphere().positions);
+  mesh.indices = std::make_shared<const std::vector<uint32_t>>(sphere().indices);
+  REQUIRE(f.owner->requestShared(0, 7, 1, mesh, Pose{}, GridBox::referenceDefault()) == Status::ok);
+  // The request holds the owner's arrays themselves.
+  CHECK(mesh.positions.use_count() == 2);
+  CHECK(mesh.indices.use_count() == 2);
+  REQUIRE(f.mailbox->pump(false));
+  CHECK(f.log->requests == 1);
+  CHECK(f.log->lastMesh == sphere().positions);
+  // Handed down, the request no longer holds them.
+  CHECK(mesh.positions.use_count() == 1);
+  CHECK(mesh.indices.use_count() == 1);
+  CHECK(f.owner->requestShared(1, 7, 1, SharedMesh{}, Pose{}, GridBox::referenceDefault()) ==
+        Status::invalid_argument);
 }

@@ -73,14 +73,19 @@ Status GraspSession::configure(const GraspSettings& settings) {
   return Status::ok;
 }
 
-Status GraspSession::addTarget(uint64_t id, TriangleMesh mesh) {
+Status GraspSession::addTarget(uint64_t id, TriangleMesh mesh, SharedMesh deviceCopy) {
   if (targets_.count(id) != 0) return Status::invalid_argument;
   Target t;
   t.meshTarget = true;
   // The set-up (a second for a few hundred thousand triangles) is the worker's; the target is
   // graspable once it is ready (refreshSetups).
-  if (deferredUsable() && deferredForMeshTargets_)
-    t.deviceCopy = std::make_unique<TriangleMesh>(mesh);
+  if (deferredUsable() && deferredForMeshTargets_) {
+    if (deviceCopy.positions == nullptr || deviceCopy.indices == nullptr) {
+      deviceCopy.positions = std::make_shared<const std::vector<glm::vec3>>(mesh.positions);
+      deviceCopy.indices = std::make_shared<const std::vector<uint32_t>>(mesh.indices);
+    }
+    t.deviceCopy = std::move(deviceCopy);
+  }
   t.setup = TargetSetup::pending;
   t.vertexCount = mesh.positions.size();
   worker_->addTarget(id, std::move(mesh));
@@ -127,8 +132,8 @@ void GraspSession::refreshSetups() {
       if (t.version == 0) t.bounds = info.bounds;
       t.setup = TargetSetup::ready;
       // The GPU's copy takes the triangles as the set-up welded them and turned them outward.
-      if (t.deviceCopy != nullptr && info.orientedIndices != nullptr)
-        t.deviceCopy->indices = *info.orientedIndices;
+      if (t.deviceCopy.indices != nullptr && info.orientedIndices != nullptr)
+        t.deviceCopy.indices = info.orientedIndices;
       setupReports_.emplace_back(id, info.found);
       reindex(id, t);
     } else if (info.setup == TargetSetup::failed) {
@@ -293,8 +298,9 @@ Status GraspSession::updateTargetVertices(uint64_t id, std::span<const glm::vec3
   Target& t = it->second;
   // The refit is the worker's, before its next build of this target (latest positions win).
   if (positions.size() != t.vertexCount) return Status::invalid_argument;
-  if (t.deviceCopy != nullptr) {
-    std::copy(positions.begin(), positions.end(), t.deviceCopy->positions.begin());
+  if (t.deviceCopy.positions != nullptr) {
+    t.deviceCopy.positions =
+        std::make_shared<const std::vector<glm::vec3>>(positions.begin(), positions.end());
   }
   t.bounds = computeBounds(positions);
   ++t.version;
@@ -306,12 +312,28 @@ Status GraspSession::updateTargetVertices(uint64_t id, std::span<const glm::vec3
 
 Status GraspSession::updateTargetVertices(uint64_t id, std::vector<glm::vec3>&& positions,
                                           const Aabb& bounds) {
+  std::shared_ptr<const std::vector<glm::vec3>> devicePositions;
+  return updateTargetVertices(id, std::move(positions), bounds, devicePositions);
+}
+
+bool GraspSession::wantsDevicePositions(uint64_t id) const {
+  auto it = targets_.find(id);
+  return it != targets_.end() && it->second.deviceCopy.positions != nullptr && deferredUsable();
+}
+
+Status GraspSession::updateTargetVertices(
+    uint64_t id, std::vector<glm::vec3>&& positions, const Aabb& bounds,
+    std::shared_ptr<const std::vector<glm::vec3>>& devicePositions) {
   auto it = targets_.find(id);
   if (it == targets_.end() || !it->second.meshTarget) return Status::invalid_argument;
   Target& t = it->second;
   if (positions.size() != t.vertexCount) return Status::invalid_argument;
-  if (t.deviceCopy != nullptr)
-    std::copy(positions.begin(), positions.end(), t.deviceCopy->positions.begin());
+  if (t.deviceCopy.positions != nullptr) {
+    // The copy the mailbox may still hold is replaced, never written: it goes back to the caller.
+    if (devicePositions == nullptr || devicePositions->size() != positions.size())
+      devicePositions = std::make_shared<const std::vector<glm::vec3>>(positions);
+    std::swap(t.deviceCopy.positions, devicePositions);
+  }
   t.bounds = bounds;
   ++t.version;
   reindex(id, t);
@@ -520,9 +542,12 @@ Status GraspSession::solve(HandState& hand, size_t slot,
     // keep the hand waiting. A preparation that failed leaves the CPU only.
     if (device && deferredUsable()) return Status::ok;
   } else if (onDevice) {
-    const TriangleMesh* mesh = first.deviceCopy.get();
-    const Status s =
-        deferred_->request(slot, id, first.version, mesh, members[0].objectFromHand, settings_.box);
+    // The arrays are shared with the backend, not copied: this runs under the owner's lock.
+    const Status s = first.deviceCopy.positions != nullptr
+                         ? deferred_->requestShared(slot, id, first.version, first.deviceCopy,
+                                                    members[0].objectFromHand, settings_.box)
+                         : deferred_->request(slot, id, first.version, nullptr,
+                                              members[0].objectFromHand, settings_.box);
     if (s == Status::ok) {
       hand.pending = true;
       hand.pendingSince = std::chrono::steady_clock::now();

@@ -171,7 +171,10 @@ class GraspSession {
   // validateMesh, the winding, bounds, BVH, exact distance) runs on the worker. The target is not
   // graspable until targetSetup() says ready; a set-up failure is reported once by
   // takeSetupFailures().
-  Status addTarget(uint64_t id, TriangleMesh mesh);
+  // On a session whose deferred backend builds mesh targets too, it gets its own copy of the
+  // arrays: `deviceCopy` when given (the same arrays, copied by a caller that holds a lock before
+  // taking it), else a copy made here.
+  Status addTarget(uint64_t id, TriangleMesh mesh, SharedMesh deviceCopy = {});
   // ready for device targets at once.
   TargetSetup targetSetup(uint64_t id) const;
   // What each set-up finished since the last call found of its mesh: split vertices welded,
@@ -224,8 +227,17 @@ class GraspSession {
   // spaces of the last update (the broad phase; for tools and tests).
   std::vector<SceneHit> targetsNear(const Pose& worldFromBox, const glm::vec3& half) const;
   // The same, handing over `positions` and their bounds (computed by the caller while it filled
-  // them): nothing is copied. Fill a buffer from vertexBuffer() to allocate nothing.
+  // them): nothing is copied, but for the deferred backend's copy of a target it builds
+  // (wantsDevicePositions). Fill a buffer from vertexBuffer() to allocate nothing.
   Status updateTargetVertices(uint64_t id, std::vector<glm::vec3>&& positions, const Aabb& bounds);
+  // The same with that copy made by the caller (before taking its lock): `devicePositions` is
+  // handed over on success and comes back holding the copy it replaced, for the caller to free
+  // after its lock. Null: made here when needed.
+  Status updateTargetVertices(uint64_t id, std::vector<glm::vec3>&& positions, const Aabb& bounds,
+                              std::shared_ptr<const std::vector<glm::vec3>>& devicePositions);
+  // Whether the deferred backend builds target `id` from a copy of its positions, which a vertex
+  // update must then bring (see updateTargetVertices).
+  bool wantsDevicePositions(uint64_t id) const;
   // A buffer the worker is done with, sized for target `id`'s positions when it has one (empty
   // before the first update).
   std::vector<glm::vec3> vertexBuffer(uint64_t id);
@@ -288,8 +300,9 @@ class GraspSession {
     Pose spaceFromObject;
     bool indexed = false;
     TargetSetup setup = TargetSetup::ready;
-    // With a deferred backend that builds mesh targets: the arrays it uploads.
-    std::unique_ptr<TriangleMesh> deviceCopy;
+    // With a deferred backend that builds mesh targets: the arrays it uploads, shared with it
+    // and never changed (new positions, and the set-up's outward indices, replace a pointer).
+    SharedMesh deviceCopy;
     size_t vertexCount = 0;  // what updateTargetVertices must match
     Aabb bounds;
     uint64_t version = 0;

@@ -1,5 +1,6 @@
 #include "sdf/deferred_mailbox.h"
 
+#include <exception>
 #include <utility>
 
 namespace sdfg {
@@ -8,8 +9,20 @@ class DeferredMailbox::OwnerSide final : public DeferredSdfBackend {
  public:
   explicit OwnerSide(std::shared_ptr<DeferredMailbox> mailbox) : mailbox_(std::move(mailbox)) {}
   std::string_view name() const override { return "mailbox"; }
+  // Lent arrays must outlive the call, so they are copied (here, under no lock of the mailbox's);
+  // an owner that holds a lock shares its arrays through requestShared instead.
   Status request(size_t slot, uint64_t id, uint64_t version, const TriangleMesh* mesh,
                  const Pose& objectFromHand, const GridBox& box) override {
+    SharedMesh shared;
+    if (mesh != nullptr) {
+      shared.positions = std::make_shared<const std::vector<glm::vec3>>(mesh->positions);
+      shared.indices = std::make_shared<const std::vector<uint32_t>>(mesh->indices);
+    }
+    return mailbox_->request(slot, id, version, std::move(shared), objectFromHand, box);
+  }
+  Status requestShared(size_t slot, uint64_t id, uint64_t version, const SharedMesh& mesh,
+                       const Pose& objectFromHand, const GridBox& box) override {
+    if (mesh.positions == nullptr || mesh.indices == nullptr) return Status::invalid_argument;
     return mailbox_->request(slot, id, version, mesh, objectFromHand, box);
   }
   bool hasDeviceMesh(uint64_t id) const override { return mailbox_->hasDeviceMesh(id); }
@@ -24,11 +37,33 @@ class DeferredMailbox::OwnerSide final : public DeferredSdfBackend {
   std::shared_ptr<DeferredMailbox> mailbox_;
 };
 
-DeferredMailbox::DeferredMailbox(std::unique_ptr<DeferredSdfBackend> device)
-    : device_(std::move(device)) {}
+// The device for one thread, from construction (the taker holds mutex_ and found it free) to
+// destruction, which gives it back and wakes the threads waiting for it, also while an exception
+// from a device call unwinds. It takes mutex_ itself: a Claim is declared before the
+// unique_lock of its scope, so that unwinding unlocks first.
+class DeferredMailbox::Claim {
+ public:
+  explicit Claim(DeferredMailbox& mailbox) : mailbox_(mailbox) { mailbox_.claimed_ = true; }
+  ~Claim() {
+    {
+      std::lock_guard lock(mailbox_.mutex_);
+      mailbox_.claimed_ = false;
+    }
+    mailbox_.released_.notify_all();
+  }
+  Claim(const Claim&) = delete;
+  Claim& operator=(const Claim&) = delete;
+
+ private:
+  DeferredMailbox& mailbox_;
+};
+
+DeferredMailbox::DeferredMailbox(std::unique_ptr<DeferredSdfBackend> device,
+                                 std::chrono::milliseconds claimWait)
+    : claimWait_(claimWait), device_(std::move(device)) {}
 
 DeferredMailbox::~DeferredMailbox() {
-  shutdown();
+  (void)shutdown();
 }
 
 std::unique_ptr<DeferredSdfBackend> DeferredMailbox::ownerSide(
@@ -36,9 +71,8 @@ std::unique_ptr<DeferredSdfBackend> DeferredMailbox::ownerSide(
   return std::make_unique<OwnerSide>(std::move(mailbox));
 }
 
-Status DeferredMailbox::request(size_t slot, uint64_t id, uint64_t version,
-                                const TriangleMesh* mesh, const Pose& objectFromHand,
-                                const GridBox& box) {
+Status DeferredMailbox::request(size_t slot, uint64_t id, uint64_t version, SharedMesh mesh,
+                                const Pose& objectFromHand, const GridBox& box) {
   if (slot >= kSlots || box.validate()) return Status::invalid_argument;
   std::lock_guard lock(mutex_);
   if (failed_) return Status::device_lost;
@@ -50,17 +84,8 @@ Status DeferredMailbox::request(size_t slot, uint64_t id, uint64_t version,
   r.version = version;
   r.objectFromHand = objectFromHand;
   r.box = box;
-  if (mesh != nullptr) {
-    // The pump reads the mesh on another thread while the owner may change its own copy: the
-    // request carries one of its own, made again only for new vertices or another target.
-    MeshCopy& copy = meshes_[slot];
-    if (copy.mesh == nullptr || copy.id != id || copy.version != version) {
-      copy.mesh = std::make_shared<const TriangleMesh>(*mesh);
-      copy.id = id;
-      copy.version = version;
-    }
-    r.mesh = copy.mesh;
-  }
+  // Shared, never copied here: the owner calls this under its session lock.
+  r.mesh = std::move(mesh);
   r.generation = ++s.generation;
   s.result.reset();
   s.queued = std::move(r);
@@ -128,55 +153,92 @@ void DeferredMailbox::post(std::function<void(DeferredSdfBackend&)> call) {
   posted_.push_back(std::move(call));
 }
 
-bool DeferredMailbox::claim(std::unique_lock<std::mutex>& lock) {
-  released_.wait(lock, [&] { return !claimed_; });
-  if (device_ == nullptr) return false;
-  claimed_ = true;
-  return true;
+DeferredMailbox::Access DeferredMailbox::waitToClaim(std::unique_lock<std::mutex>& lock,
+                                                     std::optional<Claim>& claim) {
+  const bool free = released_.wait_for(lock, claimWait_, [&] { return !claimed_ || closed_; });
+  if (closed_ || device_ == nullptr) return Access::shut_down;
+  if (!free) return Access::timed_out;
+  claim.emplace(*this);
+  return Access::done;
 }
 
-void DeferredMailbox::release(std::unique_lock<std::mutex>& lock) {
-  if (!lock.owns_lock()) lock.lock();
-  claimed_ = false;
-  lock.unlock();
-  released_.notify_all();
+void DeferredMailbox::requeue(std::vector<std::function<void(DeferredSdfBackend&)>>& posted,
+                              size_t from) {
+  if (from >= posted.size()) return;
+  // In front of what was posted meanwhile: posted calls run in the order posted.
+  posted_.insert(posted_.begin(), std::make_move_iterator(posted.begin() + ptrdiff_t(from)),
+                 std::make_move_iterator(posted.end()));
 }
 
-void DeferredMailbox::exclusive(const std::function<void(DeferredSdfBackend&)>& call) {
+DeferredMailbox::Access DeferredMailbox::exclusive(
+    const std::function<void(DeferredSdfBackend&)>& call) {
+  std::optional<Claim> claim;  // before `lock`: see Claim
   std::unique_lock lock(mutex_);
-  if (!claim(lock)) return;
+  if (const Access a = waitToClaim(lock, claim); a != Access::done) return a;
   std::vector<std::function<void(DeferredSdfBackend&)>> posted = std::move(posted_);
   posted_.clear();
+  DeferredSdfBackend& device = *device_;
   lock.unlock();
-  for (auto& f : posted) f(*device_);
-  call(*device_);
-  const bool failed = device_->failed();
+  size_t tried = 0;
+  try {
+    for (; tried < posted.size(); ++tried) posted[tried](device);
+    call(device);
+  } catch (...) {
+    const bool failed = device.failed();
+    lock.lock();
+    failed_ = failed_ || failed;
+    requeue(posted, tried + 1);
+    throw;
+  }
+  const bool failed = device.failed();
   lock.lock();
   failed_ = failed_ || failed;
-  release(lock);
+  return Access::done;
 }
 
-void DeferredMailbox::shutdown() {
+bool DeferredMailbox::shutdown() {
   std::unique_ptr<DeferredSdfBackend> device;
+  bool inTime = true;
   {
     std::unique_lock lock(mutex_);
-    released_.wait(lock, [&] { return !claimed_; });
-    device = std::move(device_);
-    posted_.clear();
-    failed_ = true;
+    if (!std::exchange(closed_, true)) {
+      failed_ = true;
+      posted_.clear();
+      // An exclusive call waiting for the device has nothing more to wait for.
+      released_.notify_all();
+    }
+    inTime = released_.wait_for(lock, claimWait_, [&] { return !claimed_; });
+    if (inTime) device = std::move(device_);
   }
   device.reset();  // waits for its work in flight, with no lock held
+  return inTime;
+}
+
+const TriangleMesh* DeferredMailbox::assemble(size_t slot, const Request& r) {
+  if (r.mesh.positions == nullptr || r.mesh.indices == nullptr) return nullptr;
+  Assembled& a = assembled_[slot];
+  if (!a.valid || a.id != r.id || a.version != r.version) {
+    a.valid = false;
+    a.mesh.positions = *r.mesh.positions;
+    a.mesh.indices = *r.mesh.indices;
+    a.id = r.id;
+    a.version = r.version;
+    a.valid = true;
+  }
+  return &a.mesh;
 }
 
 bool DeferredMailbox::pump(bool sharedQueueFree) {
   std::array<Seen, kSlots> seen;  // a refused request is simply not started: poll() says idle
   std::array<bool, kSlots> cancels{};
+  std::array<bool, kSlots> cancelled{};
   std::array<bool, kSlots> inFlight{};
   std::vector<std::function<void(DeferredSdfBackend&)>> posted;
+  std::optional<Claim> claim;  // before `lock`: see Claim
   std::unique_lock lock(mutex_);
   // Never wait for another thread's device calls: it does this work, or the next pump will.
-  if (claimed_ || device_ == nullptr) return false;
-  claimed_ = true;
+  if (claimed_ || closed_ || device_ == nullptr) return false;
+  claim.emplace(*this);
   posted = std::move(posted_);
   posted_.clear();
   for (size_t i = 0; i < kSlots; ++i) {
@@ -186,30 +248,44 @@ bool DeferredMailbox::pump(bool sharedQueueFree) {
     s.queued.reset();
     inFlight[i] = s.onDevice;
   }
+  DeferredSdfBackend& device = *device_;
   lock.unlock();
 
-  DeferredSdfBackend& device = *device_;
-  for (auto& f : posted) f(device);
-  for (size_t i = 0; i < kSlots; ++i)
-    if (cancels[i]) device.cancel(i);
-  const bool ready = device.ready();
-  for (size_t i = 0; i < kSlots; ++i) {
-    Seen& v = seen[i];
-    if (!v.request) continue;
-    const Request& r = *v.request;
-    const Status st = device.request(i, r.id, r.version, r.mesh.get(), r.objectFromHand, r.box);
-    v.started = st == Status::ok;
-    v.busy = st == Status::unsupported;
-  }
-  if (device.needsSubmit(sharedQueueFree)) (void)device.submit(sharedQueueFree);
-  for (size_t i = 0; i < kSlots; ++i) {
-    Seen& v = seen[i];
-    if (!inFlight[i] && !v.started) continue;
-    v.polled = true;
-    v.poll = device.poll(i, v.grid);
+  size_t postedTried = 0;
+  bool ready = false;
+  bool needsSubmit = true;  // what an interrupted pump leaves: the next one looks again
+  bool finished = false;
+  std::exception_ptr thrown;
+  try {
+    for (; postedTried < posted.size(); ++postedTried) posted[postedTried](device);
+    for (size_t i = 0; i < kSlots; ++i) {
+      if (!cancels[i]) continue;
+      cancelled[i] = true;
+      device.cancel(i);
+    }
+    ready = device.ready();
+    for (size_t i = 0; i < kSlots; ++i) {
+      Seen& v = seen[i];
+      if (!v.request) continue;
+      const Request& r = *v.request;
+      v.tried = true;
+      const Status st = device.request(i, r.id, r.version, assemble(i, r), r.objectFromHand, r.box);
+      v.started = st == Status::ok;
+      v.busy = st == Status::unsupported;
+    }
+    if (device.needsSubmit(sharedQueueFree)) (void)device.submit(sharedQueueFree);
+    for (size_t i = 0; i < kSlots; ++i) {
+      Seen& v = seen[i];
+      if (!inFlight[i] && !v.started) continue;
+      v.poll = device.poll(i, v.grid);
+      v.polled = true;
+    }
+    needsSubmit = device.needsSubmit(true);
+    finished = true;
+  } catch (...) {
+    thrown = std::current_exception();
   }
   const bool failed = device.failed();
-  const bool needsSubmit = device.needsSubmit(true);
 
   lock.lock();
   for (size_t i = 0; i < kSlots; ++i) {
@@ -224,13 +300,23 @@ bool DeferredMailbox::pump(bool sharedQueueFree) {
       s.onDevice = false;
       if (current && v.poll == BuildPoll::ready) s.result = std::move(v.grid);
     }
-    if (v.busy && !s.queued && v.request->generation == s.generation)
+    // Busy, or not reached before a device call threw: again at the next pump, unless the owner
+    // asked anew meanwhile.
+    const bool again = v.busy || (v.request && !v.tried);
+    if (again && !s.queued && v.request->generation == s.generation)
       s.queued = std::move(v.request);
+    if (cancels[i] && !cancelled[i] && s.onDevice) s.cancel = true;
   }
   failed_ = failed_ || failed;
-  ready_ = ready;
+  if (finished) ready_ = ready;
   deviceNeedsSubmit_ = needsSubmit;
-  release(lock);
+  if (thrown) {
+    // The call that threw is dropped; those after it run at the next pump.
+    requeue(posted, postedTried + 1);
+    lock.unlock();
+    claim.reset();
+    std::rethrow_exception(thrown);
+  }
   return true;
 }
 

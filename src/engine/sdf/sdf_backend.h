@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <string_view>
+#include <vector>
 
 #include "base/pose.h"
 #include "base/status.h"
@@ -44,6 +45,14 @@ enum class BuildPoll {
   failed,   // the device failed; the backend is unusable from now on
 };
 
+// A mesh handed to a backend that may keep it past the call (DeferredMailbox keeps it until its
+// next pump): nobody changes what it points to once shared, so new positions come as a new
+// `positions` beside the same `indices`, and no one copies a mesh while holding a lock.
+struct SharedMesh {
+  std::shared_ptr<const std::vector<glm::vec3>> positions;
+  std::shared_ptr<const std::vector<uint32_t>> indices;
+};
+
 // A backend that builds on a device queue its owner may use only at certain moments (the app's
 // Vulkan queue, which the layer may touch only inside xrBeginFrame / xrEndFrame). request()
 // records a build and returns at once; submit() hands every recorded build to the device and
@@ -65,6 +74,16 @@ class DeferredSdfBackend {
   // slot has a build recorded or running), device_lost / out_of_memory / internal (failed).
   virtual Status request(size_t slot, uint64_t id, uint64_t version, const TriangleMesh* mesh,
                          const Pose& objectFromHand, const GridBox& box) = 0;
+  // request() with a mesh of CPU arrays shared instead of lent: a backend that keeps the mesh
+  // past the call keeps these pointers, which is what lets an owner request under its lock. By
+  // default the arrays are copied into a TriangleMesh for request(). Errors as request();
+  // invalid_argument for a null array.
+  virtual Status requestShared(size_t slot, uint64_t id, uint64_t version, const SharedMesh& mesh,
+                               const Pose& objectFromHand, const GridBox& box) {
+    if (mesh.positions == nullptr || mesh.indices == nullptr) return Status::invalid_argument;
+    const TriangleMesh copy{*mesh.positions, *mesh.indices};
+    return request(slot, id, version, &copy, objectFromHand, box);
+  }
   // Whether `id` names a mesh registered with the concrete backend (the app's device buffers).
   virtual bool hasDeviceMesh(uint64_t id) const = 0;
   // Whether a recorded build waits for submit(sharedQueueFree).

@@ -344,6 +344,7 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
   if (XrResult r = verifyPlacement(cmd, &createInfo->placement); r != XR_SUCCESS) return r;
   // The checks and the copy of the app's arrays (up to 2^24 vertices) happen before the lock.
   TriangleMesh mesh;
+  SharedMesh deviceCopy;
   AnalyticShape shape;
   if (shapeInfo != nullptr) {
     if (XrResult r = readShape(cmd, shapeInfo, shape); r != XR_SUCCESS) return r;
@@ -354,6 +355,11 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
     if (XrResult r = verifyBuffers(cmd, buffers, nullptr); r != XR_SUCCESS) return r;
   } else if (XrResult r = copyArrays(cmd, arrays, mesh); r != XR_SUCCESS) {
     return r;
+  } else if (s->gpuForArrayTargets) {
+    // The GPU path's own copy, made here rather than by the engine under the lock. The flag is
+    // fixed when the session is made.
+    deviceCopy.positions = std::make_shared<const std::vector<glm::vec3>>(mesh.positions);
+    deviceCopy.indices = std::make_shared<const std::vector<uint32_t>>(mesh.indices);
   }
   auto t = std::make_shared<TargetState>();
   t->handle = newLayerHandle();
@@ -389,7 +395,7 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
       // The rest of the set-up runs on the session's worker: the zero-area check, turning every
       // part outward (meshes come wound either way, or both), the BVH. syncGrasps logs once what
       // it found, or why it refused the mesh, and XrGraspTargetsSetupInfoSDFG reports it.
-      status = s->grasp->addTarget(t->handle, std::move(mesh));
+      status = s->grasp->addTarget(t->handle, std::move(mesh), std::move(deviceCopy));
     }
     if (refusal == Refusal::none && status == Status::ok) {
       applyTargetSettings(*s, t->handle, settings);
@@ -485,24 +491,32 @@ XrResult XRAPI_CALL SdfgXrUpdateGraspTargetVerticesSDFG(XrGraspTargetSDFG target
   // and refusing positions that collapse a triangle (the target keeps its last shape; syncGrasps
   // logs it once). Checked here, that gather over every triangle was most of the 3.9 ms a frame
   // the 400k-triangle armadillo's updates cost (docs/benchmarks.md, frame cost).
+  // On a session whose GPU builds array targets, the GPU path's copy of the positions is made
+  // outside the lock too, and the one it replaces is freed after it.
   std::vector<glm::vec3> positions;
+  bool deviceCopy = false;
   {
     std::lock_guard lock(s->mutex);
-    if (s->grasp == nullptr)
+    if (s->grasp == nullptr) {
       refusal = Refusal::sessionLost;
-    else
+    } else {
       positions = s->grasp->vertexBuffer(t->handle);
+      deviceCopy = s->grasp->wantsDevicePositions(t->handle);
+    }
   }
   if (refusal != Refusal::none) return refuse(cmd, refusal);
   Aabb bounds;
   if (XrResult r = copyVertices(cmd, v, t->vertexCount, positions, bounds); r != XR_SUCCESS)
     return r;
+  std::shared_ptr<const std::vector<glm::vec3>> devicePositions;
+  if (deviceCopy) devicePositions = std::make_shared<const std::vector<glm::vec3>>(positions);
   {
     std::lock_guard lock(s->mutex);
     if (s->grasp == nullptr)
       refusal = Refusal::sessionLost;
     else
-      status = s->grasp->updateTargetVertices(t->handle, std::move(positions), bounds);
+      status =
+          s->grasp->updateTargetVertices(t->handle, std::move(positions), bounds, devicePositions);
   }
   if (refusal == Refusal::none && status != Status::ok) refusal = Refusal::engine;
   return refuse(cmd, refusal, status);

@@ -94,8 +94,14 @@ void endSessionWork(SessionState& s) {
   // destroys the session, holding no lock another call could need.
   grasp.reset();
   // Waits for the layer's builds in flight on the app's device and frees the layer's objects
-  // there, while the device surely exists (the app destroys it after the session).
-  if (gpu != nullptr) gpu->shutdown();
+  // there, while the device surely exists (the app destroys it after the session). A device
+  // call on another thread that outlasts the mailbox's bound is not waited for (the session is
+  // destroyed anyway): that thread frees the objects when its call returns.
+  if (gpu != nullptr && !gpu->shutdown())
+    SDFG_LOG_WARN("xrDestroySession",
+                  "a GPU call on another thread still runs after %lld ms; the layer's objects on "
+                  "the app's device are freed when it returns",
+                  static_cast<long long>(DeferredMailbox::kClaimWait.count()));
 }
 
 XrResult XRAPI_CALL SdfgXrGetSystemProperties(XrInstance instance, XrSystemId systemId,

@@ -12,6 +12,7 @@
 //   a spare one (xrCreateVulkanDeviceKHR); builds of CPU-array targets go there right after
 //   xrSyncActions.
 // - Failures: the backend logs one line and the session continues on the CPU.
+#include <exception>
 #include <vector>
 
 #include "intercepts.h"
@@ -133,7 +134,16 @@ void pumpGpu(SessionState& s, bool inFrame) {
   }
   // A pump on another thread is not waited for: it, or the next, does the work. A device
   // failure is the backend's to log (once) and shows in the engine as failed (CPU from then on).
-  if (gpu != nullptr) (void)gpu->pump(inFrame);
+  if (gpu == nullptr) return;
+  // A device call that throws (out of memory in the backend) ends the pump only: the mailbox has
+  // given the device back, and the app's call, whose own work is done, succeeds.
+  try {
+    (void)gpu->pump(inFrame);
+  } catch (const std::exception& e) {
+    SDFG_LOG_WARN("sdfg vulkan", "a GPU call failed (%s); the next pump goes on", e.what());
+  } catch (...) {
+    SDFG_LOG_WARN("sdfg vulkan", "a GPU call failed; the next pump goes on");
+  }
 }
 
 namespace {

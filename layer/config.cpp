@@ -122,7 +122,7 @@ bool applyConfigValue(Config& config, const std::string& key, const std::string&
     c.testLayerFault = value;
   } else if (key == "test_gpu_fault") {
     ok = value == "none" || value == "lost_at_submit" || value == "lost_at_poll" ||
-         value == "never_ready";
+         value == "never_ready" || value == "stuck_reads_once";
     c.testGpuFault = value;
   } else {
     ok = false;

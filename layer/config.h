@@ -35,7 +35,8 @@ struct Config {
   Gpu gpu = Gpu::automatic;
   bool extraQueue = true;  // extra_queue: add a queue to Vulkan2 apps' devices when one is spare
   // test_gpu_fault: none, lost_at_submit, lost_at_poll (tests only: a simulated device loss),
-  // never_ready (the GPU path never finishes preparing, as if the driver compiled forever)
+  // never_ready (the GPU path never finishes preparing, as if the driver compiled forever),
+  // stuck_reads_once (the first removal of a buffer target finds the GPU still reading it)
   std::string testGpuFault = "none";
   // test_layer_fault: none, or the point after a successful call down where the layer throws
   // (test_fault.h), to check that it gives back what the runtime made.

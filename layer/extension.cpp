@@ -292,20 +292,64 @@ void postDeviceMesh(DeferredMailbox& gpu, uint64_t id, const XrGraspTargetVulkan
 #endif
 }
 
-void removeDeviceMesh(DeferredMailbox& gpu, uint64_t id, bool wait) {
+// The GPU path forgets a buffer target the engine refused, at the next pump: nothing read it.
+void forgetDeviceMesh(DeferredMailbox& gpu, uint64_t id) {
   gpu.noteDeviceMesh(id, false);
 #if SDFG_LAYER_VULKAN
-  const auto remove = [id](DeferredSdfBackend& device) {
-    static_cast<VkGraspBackend&>(device).removeDeviceMesh(id);
-  };
-  // Waiting: the GPU's reads of the app's buffers end before the call returns, so the app may
-  // free them next.
-  if (wait)
-    gpu.exclusive(remove);
-  else
-    gpu.post(remove);
+  gpu.post([id](DeferredSdfBackend& device) {
+    (void)static_cast<VkGraspBackend&>(device).removeDeviceMesh(id);
+  });
 #else
-  (void)wait;
+  (void)id;
+#endif
+}
+
+// Takes the target out of its session: a hand holding it lets go (its fingers return to the
+// user's pose at the next locate), it is unplaced and leaves the session's table.
+void removeFromSession(SessionState& s, TargetState& t) {
+  std::lock_guard lock(s.mutex);
+  if (s.grasp != nullptr) {
+    for (Hand hand : {Hand::left, Hand::right}) {
+      const HandGrasp& g = s.grasp->grasp(hand);
+      if (g.holdsTarget() && g.target == t.handle)
+        noteGraspChange(s, hand, true, t.handle, /*destroyed=*/true);
+    }
+    s.grasp->removeTarget(t.handle);
+    publishShownHands(s);  // the next locate shows the hand let go
+  }
+  unplaceTarget(s, t);
+  s.targets.erase(t.handle);
+}
+
+enum class BufferTargetRemoval {
+  removed,     // from the device and the session: the GPU reads its buffers no more
+  deviceGone,  // the session's GPU path was shut down (the session is being destroyed)
+  stillRead,   // the GPU's reads did not end in time: nothing changed
+};
+
+// Removes a buffer target from the device and then from the session, with no lock held on
+// entry. The device is held meanwhile (DeferredMailbox::exclusive), so no pump submits a build
+// of the target or collects one between the two steps: either both happen, or, when the GPU's
+// reads of the app's buffers in flight do not end within the bounds (the device's 2 s, or
+// another thread holding the device as long), neither.
+BufferTargetRemoval removeBufferTarget(DeferredMailbox& gpu, SessionState& s, TargetState& t) {
+#if SDFG_LAYER_VULKAN
+  bool readsEnded = false;
+  const DeferredMailbox::Access access = gpu.exclusive([&](DeferredSdfBackend& device) {
+    readsEnded = static_cast<VkGraspBackend&>(device).removeDeviceMesh(t.handle);
+    if (!readsEnded) return;
+    gpu.noteDeviceMesh(t.handle, false);
+    // The session lock inside the device's claim: nobody waits for a claim holding that lock.
+    removeFromSession(s, t);
+  });
+  if (access == DeferredMailbox::Access::shut_down) return BufferTargetRemoval::deviceGone;
+  return access == DeferredMailbox::Access::done && readsEnded ? BufferTargetRemoval::removed
+                                                               : BufferTargetRemoval::stillRead;
+#else
+  (void)gpu;
+  (void)s;
+  (void)t;
+  return BufferTargetRemoval::deviceGone;
 #endif
 }
 
@@ -389,7 +433,7 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
         // Registered on the device by the next pump, before any build the engine asks for it.
         postDeviceMesh(*s->gpu, t->handle, *buffers);
         status = s->grasp->addDeviceTarget(t->handle, toBounds(*buffers));
-        if (status != Status::ok) removeDeviceMesh(*s->gpu, t->handle, false);
+        if (status != Status::ok) forgetDeviceMesh(*s->gpu, t->handle);
       }
     } else {
       // The rest of the set-up runs on the session's worker: the zero-area check, turning every
@@ -419,25 +463,21 @@ XrResult XRAPI_CALL SdfgXrDestroyGraspTargetSDFG(XrGraspTargetSDFG target) {
   auto [t, s] = findTarget(target);
   SDFG_VERIFY(cmd, t != nullptr, XR_ERROR_HANDLE_INVALID, "(target) is not valid");
   std::shared_ptr<DeferredMailbox> gpu;
-  {
+  if (t->deviceBuffers) {
     std::lock_guard lock(s->mutex);
-    // A hand holding it lets go; its fingers return to the user's pose at the next locate.
-    if (s->grasp != nullptr) {
-      for (Hand hand : {Hand::left, Hand::right}) {
-        const HandGrasp& g = s->grasp->grasp(hand);
-        if (g.holdsTarget() && g.target == t->handle)
-          noteGraspChange(*s, hand, true, t->handle, /*destroyed=*/true);
-      }
-      s->grasp->removeTarget(t->handle);
-      publishShownHands(*s);  // the next locate shows the hand let go
-    }
-    unplaceTarget(*s, *t);
-    s->targets.erase(t->handle);
-    if (t->deviceBuffers) gpu = s->gpu;
+    gpu = s->gpu;
   }
-  // Waits, with no lock held, for a pump in progress and then for the layer's reads of the
-  // app's buffers in flight: the app may free them when this returns.
-  if (gpu != nullptr) removeDeviceMesh(*gpu, t->handle, true);
+  // A buffer target: the layer's reads of the app's buffers end first (waited for with no lock
+  // held), so the app may free them when this returns. When they do not end in time the app
+  // must not free them: the call fails and changes nothing, and a later destroy tries again.
+  const BufferTargetRemoval removal =
+      gpu != nullptr ? removeBufferTarget(*gpu, *s, *t) : BufferTargetRemoval::deviceGone;
+  if (removal == BufferTargetRemoval::stillRead)
+    return logError(XR_ERROR_RUNTIME_FAILURE, cmd,
+                    "the GPU still reads the target's buffers (a build in flight did not end "
+                    "within the layer's bound): the target is kept unchanged; do not free its "
+                    "buffers yet, and call xrDestroyGraspTargetSDFG again");
+  if (removal != BufferTargetRemoval::removed) removeFromSession(*s, *t);
   targets().erase(t->handle);
   return XR_SUCCESS;
   SDFG_ENTRY_END(cmd)

@@ -48,6 +48,7 @@ VkGraspFault faultFromConfig(const std::string& name) {
   if (name == "lost_at_submit") return VkGraspFault::lostAtSubmit;
   if (name == "lost_at_poll") return VkGraspFault::lostAtPoll;
   if (name == "never_ready") return VkGraspFault::neverReady;
+  if (name == "stuck_reads_once") return VkGraspFault::stuckReadsOnce;
   return VkGraspFault::none;
 }
 #endif

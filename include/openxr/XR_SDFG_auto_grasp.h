@@ -123,7 +123,8 @@ typedef struct XrGraspTargetVerticesSDFG {
 // - Index k is a uint16 or uint32 (indexType) at indexOffset + k * index size bytes.
 // - Both buffers need VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, must be usable on the binding's queue
 //   family (exclusive to it, or concurrent), and must stay alive until the target is destroyed
-//   (xrDestroyGraspTargetSDFG waits for the layer's reads in flight) or replaced by an update.
+//   (xrDestroyGraspTargetSDFG waits for the layer's reads in flight and returns XR_SUCCESS once
+//   they ended; see it for a device that does not end them) or replaced by an update.
 // - Writes: the layer reads the buffers in command buffers it submits on the binding's queue
 //   inside xrBeginFrame / xrEndFrame. Submit the commands that write them (skinning) on that
 //   queue before the xrEndFrame of the frame whose xrSyncActions should see them, and do not
@@ -254,7 +255,11 @@ typedef struct XrGraspOptionsSDFG {
 typedef XrResult(XRAPI_PTR* PFN_xrCreateGraspTargetSDFG)(
     XrSession session, const XrGraspTargetCreateInfoSDFG* createInfo, XrGraspTargetSDFG* target);
 // Removes `target`; a hand holding it lets go. Errors: HANDLE_INVALID (null, destroyed, or its
-// session destroyed).
+// session destroyed). A target in Vulkan buffers: the call first waits for the layer's reads of
+// the buffers in flight (at most 2 s for each build, and as long for a GPU call of another
+// thread to end), so the app may free them once it returns XR_SUCCESS. RUNTIME_FAILURE when a read
+// still runs after that (a hung device): nothing changed, the target stays valid (placed, held
+// if it was), the buffers must stay alive, and the app may destroy it again later.
 typedef XrResult(XRAPI_PTR* PFN_xrDestroyGraspTargetSDFG)(XrGraspTargetSDFG target);
 // New vertex positions (same count, same topology): animated and skinned meshes. Pass an
 // XrGraspTargetVerticesSDFG with indexCount 0 and indices NULL (array targets), or an

@@ -253,6 +253,58 @@ TEST_CASE("A target in the app's Vulkan buffers (strided, 16-bit indices) is gra
   CHECK(vulkanMessages().size() == messagesBefore);
 }
 
+TEST_CASE("Destroying a buffer target the GPU still reads fails, keeps the target, and works later",
+          "[layer][vulkan]") {
+  if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+  const XrVector3f centre = boxCentreInLocal(grip, /*right=*/true);
+  const TestMesh sphere = makeIcosphere(0.04f, 3);
+  // The layer's test-only key test_gpu_fault (docs/layer.md): the first removal of a buffer
+  // target finds the GPU still reading its buffers, as after the layer's 2 s wait on a hung
+  // device (without the wait).
+  XrEnv env = squeezeEnv(grip);
+  env.extra.push_back({"SDFG_AUTOGRASP_TEST_GPU_FAULT", "stuck_reads_once"});
+  applyEnv(env);
+  const size_t messagesBefore = vulkanMessages().size();
+  {
+    App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME},
+             true,
+             Graphics::vulkan2});
+    REQUIRE(app.ok());
+    Ext ext(app);
+    auto targetState = app.fn<PFN_xrGetGraspTargetStateSDFG>("xrGetGraspTargetStateSDFG");
+    REQUIRE(targetState != nullptr);
+    makeTracker(app, ext, XR_HAND_RIGHT_EXT);
+    BufferMesh m = uploadMesh(app, sphere, 1.0f);
+    XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &m.desc};
+    ci.placement = {
+        XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, app.local, {{0, 0, 0, 1}, centre}};
+    XrGraspTargetSDFG t = XR_NULL_HANDLE;
+    REQUIRE(ext.create(app.session, &ci, &t) == XR_SUCCESS);
+    State s = runUntilGrasping(app, ext);
+    REQUIRE(s.state.isGrasping);
+    REQUIRE(s.state.target == t);
+
+    // The app must keep its buffers: an error, and nothing changed (still placed, still held).
+    CHECK(ext.destroy(t) == XR_ERROR_RUNTIME_FAILURE);
+    XrGraspTargetStateSDFG placed{XR_TYPE_GRASP_TARGET_STATE_SDFG};
+    CHECK(targetState(t, &placed) == XR_SUCCESS);
+    CHECK(placed.isPlaced == XR_TRUE);
+    app.frames(2);
+    s = graspState(app, ext);
+    CHECK(s.state.isGrasping);
+    CHECK(s.state.target == t);
+
+    // Called again once the reads have ended: the target goes and the hand lets go.
+    CHECK(ext.destroy(t) == XR_SUCCESS);
+    CHECK(targetState(t, &placed) == XR_ERROR_HANDLE_INVALID);
+    CHECK_FALSE(graspState(app, ext).state.isGrasping);
+    CHECK(ext.destroy(t) == XR_ERROR_HANDLE_INVALID);
+  }  // the app frees its buffers and destroys its device: nothing of the layer's is left there
+  CHECK(validationLog().empty());
+  CHECK(vulkanMessages().size() == messagesBefore);
+}
+
 TEST_CASE(
     "Destroying the session or the instance with a GPU build in flight neither hangs nor "
     "leaks",

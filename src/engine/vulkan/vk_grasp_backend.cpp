@@ -326,24 +326,30 @@ Status VkGraspBackend::setDeviceMesh(uint64_t id, const VkMeshBuffers& buffers) 
   return Status::ok;
 }
 
-void VkGraspBackend::removeDeviceMesh(uint64_t id) {
+bool VkGraspBackend::removeDeviceMesh(uint64_t id) {
+  if (fault_ == VkGraspFault::stuckReadsOnce && deviceMeshes_.count(id) != 0) {
+    fault_ = VkGraspFault::none;
+    return false;
+  }
+  // The reads in flight end first: the app may destroy its buffers once this returns true.
+  for (Slot& s : slots_) {
+    Builder* b = s.active;
+    if (!s.inFlight || b == nullptr || !b->builder || !b->meshOnDevice || b->meshId != id) continue;
+    const SdfPoll p = b->builder->wait(kDestroyWaitNs);
+    if (p == SdfPoll::pending) return false;
+    s.inFlight = false;  // its result is dropped: the owner asks again
+    if (p == SdfPoll::failed) markFailed(Status::device_lost);
+  }
   for (Slot& s : slots_) {
     for (Builder* b : {&s.main, &s.app}) {
       if (!b->builder || !b->meshOnDevice || b->meshId != id) continue;
-      if (s.active == b) {
-        s.recorded = false;
-        if (s.inFlight) {
-          // The GPU may still read the app's buffers: wait, so the app can destroy them next.
-          const SdfPoll p = b->builder->wait(kDestroyWaitNs);
-          if (p != SdfPoll::pending) s.inFlight = false;
-          if (p == SdfPoll::failed) markFailed(Status::device_lost);
-        }
-      }
+      if (s.active == b) s.recorded = false;  // recorded, not submitted: it never reads them
       b->meshId = 0;
       b->meshOnDevice = false;
     }
   }
   deviceMeshes_.erase(id);
+  return true;
 }
 
 }  // namespace sdfg

@@ -52,7 +52,9 @@ struct VkGraspBackendOptions {
 // Test hooks: a simulated VK_ERROR_DEVICE_LOST at the first submission, or at the poll after it
 // (the real work then still runs, so destruction must wait for it); or a preparation that never
 // ends (ready() stays false: a driver still compiling).
-enum class VkGraspFault { none, lostAtSubmit, lostAtPoll, neverReady };
+// stuckReadsOnce: the first removeDeviceMesh of a registered mesh finds its reads still running
+// past the bound (without waiting), as a hung device would; later ones are real.
+enum class VkGraspFault { none, lostAtSubmit, lostAtPoll, neverReady, stuckReadsOnce };
 
 class VkGraspBackend final : public DeferredSdfBackend {
  public:
@@ -80,9 +82,10 @@ class VkGraspBackend final : public DeferredSdfBackend {
   // VkMeshBuffers. Errors: invalid_argument (see VkSdfBuilder::setMesh(VkMeshBuffers)),
   // device_lost (failed), or those of VkSdfBuilder::create (app-queue builders made here).
   Status setDeviceMesh(uint64_t id, const VkMeshBuffers& buffers);
-  // Forgets the mesh of `id`; first waits (at most 2 s) for a build in flight that reads its
-  // buffers, so the app may destroy them when this returns.
-  void removeDeviceMesh(uint64_t id);
+  // Forgets the mesh of `id`; first waits (at most 2 s a slot) for the builds in flight that read
+  // its buffers, so the app may destroy them when this returns true. False: a build still reads
+  // them after that wait, and the mesh stays registered (call again later).
+  bool removeDeviceMesh(uint64_t id);
 
   void injectFault(VkGraspFault fault) { fault_ = fault; }
   // Whether CPU targets build on a queue of the layer's own.

@@ -40,6 +40,7 @@ const char* const kKeys[] = {"log_level",
                              "exact_check",
                              "sdf_far_band",
                              "synthesis",
+                             "attach_alone",
                              "gpu",
                              "extra_queue",
                              "test_gpu_fault",
@@ -86,6 +87,8 @@ bool applyConfigValue(Config& config, const std::string& key, const std::string&
     ok = parseBool(value, c.exactCheck);
   } else if (key == "synthesis") {
     ok = parseBool(value, c.synthesis);
+  } else if (key == "attach_alone") {
+    ok = parseBool(value, c.attachAlone);
   } else if (key == "gpu") {
     bool flag = false;
     ok = false;

@@ -27,6 +27,11 @@ struct Config {
   // every node exact.
   float sdfFarBand = 2.0f;
   bool synthesis = true;  // synthesis: offer XR_EXT_hand_tracking from controllers
+  // attach_alone: for an app that makes synthesized hand trackers but has attached no action
+  // sets by its first frame, attach the layer's set alone so the controllers drive the hands.
+  // Off by default: an app that attaches later is then refused (an action set can be attached
+  // once per session), and the layer never turns an app's success into a failure.
+  bool attachAlone = false;
   // gpu: where Vulkan sessions build the SDFs of array targets. auto: on the app's device unless
   // it is a CPU implementation (lavapipe, SwiftShader), where the CPU builder is faster and the
   // two would compete for the same cores; on: on the device; off: on the CPU. Targets in the app's

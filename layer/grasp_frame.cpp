@@ -1,7 +1,9 @@
-// The layer's grab update, once per sync of its action set: gather, hand over, publish.
+// The layer's grab update, once per sync of its action set (or once per frame while its set is
+// not attached: input.cpp): gather, hand over, publish.
 //
-// 1. Gather, no lock held: the squeeze of each hand (xrGetActionStateFloat), the hand (the
-//    layer's own hand tracker on the runtime, else the grip pose), and where each space that
+// 1. Gather, no lock held: the squeeze of each hand (xrGetActionStateFloat, when the layer's set
+//    is attached), the hand (the layer's own hand tracker on the runtime, used only when it marks
+//    every joint valid; else the grip pose), and where each space that
 //    holds placed targets is (one xrLocateSpace per space, whatever the number of targets in it:
 //    the engine keeps each target's pose in its space). The spaces are marked in use first, so
 //    an xrDestroySpace on another thread waits for these calls instead of the layer passing a
@@ -11,6 +13,7 @@
 //    xrLocateHandJointsEXT.
 // 3. After the unlock: the log lines of what the update found, then the GPU pump (the device
 //    calls of builds the update recorded).
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -40,6 +43,7 @@ std::optional<Pose> locate(const InstanceState& inst, XrSpace space, XrSpace bas
 // What the gather needs, copied under the lock.
 struct Plan {
   XrTime time = 0;
+  bool actions = false;  // the layer's set is attached: its squeeze and grips can be read
   XrSpace local = XR_NULL_HANDLE;
   std::array<XrSpace, 2> grips{};
   std::array<XrHandTrackerEXT, 2> trackers{};
@@ -56,10 +60,80 @@ struct Gathered {
   std::array<bool, 2> trackedValid{};
   std::array<JointPoses, 2> joints{};
   std::array<JointRadii, 2> radii{};
-  std::array<XrHandTrackerEXT, 2> created{};
-  std::array<XrResult, 2> createResult{};
   std::vector<SpaceFrame> spaces;
 };
+
+// What planGather() claimed (the uses of spaces, the hands whose tracker this call creates),
+// given back whatever happens once they were claimed (an exception in the gather or in the
+// engine's update): an xrDestroySpace on another thread waits for the uses to end, and a hand
+// left marked as being created would never get its tracker.
+class PlanClaims {
+ public:
+  PlanClaims(SessionState& s, const Plan& plan) : s_(s), plan_(plan) {}
+  PlanClaims(const PlanClaims&) = delete;
+  PlanClaims& operator=(const PlanClaims&) = delete;
+  ~PlanClaims() {
+    if (!ended_) {
+      std::lock_guard lock(s_.mutex);
+      endLocked();
+    }
+    notify();
+  }
+  // Gives the claims back; the caller holds the session's lock.
+  void endLocked() {
+    if (std::exchange(ended_, true)) return;
+    for (XrSpace space : plan_.spaces) {
+      auto use = s_.spaces.find(key(space));
+      if (use != s_.spaces.end() && --use->second.users == 0) released_ = true;
+    }
+    for (size_t h = 0; h < 2; ++h)
+      if (plan_.createTracker[h]) s_.internalTrackerCreating[h] = false;
+  }
+  // Wakes a destroy waiting for a use that ended; after the unlock.
+  void notify() {
+    if (std::exchange(released_, false)) s_.spaceReleased.notify_all();
+  }
+
+ private:
+  SessionState& s_;
+  const Plan& plan_;
+  bool ended_ = false;
+  bool released_ = false;
+};
+
+// Whether every joint's position and orientation are valid: the layer uses a runtime's hand only
+// then (an invalid joint's pose is whatever the runtime left there, often zero).
+bool allJointsValid(const std::array<XrHandJointLocationEXT, XR_HAND_JOINT_COUNT_EXT>& joints) {
+  return std::all_of(joints.begin(), joints.end(), [](const XrHandJointLocationEXT& l) {
+    return (l.locationFlags & kValidBits) == kValidBits;
+  });
+}
+
+// Asks the runtime for the layer's own tracker of hand `h` (no lock held) and stores the answer at
+// once, so nothing that fails later can lose the handle or leave the hand marked as being created.
+XrHandTrackerEXT createInternalTracker(SessionState& s, size_t h, const char* cmd) {
+  InstanceState& inst = *s.instance;
+  XrHandTrackerCreateInfoEXT info{XR_TYPE_HAND_TRACKER_CREATE_INFO_EXT};
+  info.hand = h == 0 ? XR_HAND_LEFT_EXT : XR_HAND_RIGHT_EXT;
+  info.handJointSet = XR_HAND_JOINT_SET_DEFAULT_EXT;
+  XrHandTrackerEXT made = XR_NULL_HANDLE;
+  const XrResult r = inst.next.xrCreateHandTrackerEXT(s.handle, &info, &made);
+  if (r != XR_SUCCESS) made = XR_NULL_HANDLE;
+  {
+    std::lock_guard lock(s.mutex);
+    // A refusal is remembered for the session (planGather): not retried every frame (each retry
+    // is an error line in the runtime's log).
+    if (made != XR_NULL_HANDLE)
+      s.internalTrackers[h] = made;
+    else
+      s.internalTrackerRefused[h] = true;
+  }
+  if (made == XR_NULL_HANDLE)
+    SDFG_LOG_INFO(cmd,
+                  "the runtime refused a %s hand tracker (%d); that hand follows the controller",
+                  h == 0 ? "left" : "right", int(r));
+  return made;
+}
 
 std::optional<Plan> planGather(SessionState& s) {
   std::lock_guard lock(s.mutex);
@@ -68,6 +142,7 @@ std::optional<Plan> planGather(SessionState& s) {
     return std::nullopt;
   Plan p;
   p.time = s.predictedTime;
+  p.actions = s.attached;
   p.local = s.localSpace;
   p.grips = s.gripSpaces;
   const bool runtimeHands = inst.downstreamHandTracking &&
@@ -96,32 +171,19 @@ Gathered gather(SessionState& s, const Plan& p, const char* cmd) {
   InstanceState& inst = *s.instance;
   Gathered g;
   for (size_t h = 0; h < 2; ++h) {
-    XrActionStateGetInfo get{XR_TYPE_ACTION_STATE_GET_INFO};
-    get.action = inst.squeezeAction;
-    get.subactionPath = inst.handPaths[h];
-    XrActionStateFloat state{XR_TYPE_ACTION_STATE_FLOAT};
-    g.squeezeActive[h] =
-        inst.next.xrGetActionStateFloat(s.handle, &get, &state) == XR_SUCCESS && state.isActive;
-    g.squeeze[h] =
-        g.squeezeActive[h] && std::isfinite(state.currentState) ? state.currentState : 0.0f;
-
-    XrHandTrackerEXT tracker = p.trackers[h];
-    if (p.createTracker[h]) {
-      XrHandTrackerCreateInfoEXT info{XR_TYPE_HAND_TRACKER_CREATE_INFO_EXT};
-      info.hand = h == 0 ? XR_HAND_LEFT_EXT : XR_HAND_RIGHT_EXT;
-      info.handJointSet = XR_HAND_JOINT_SET_DEFAULT_EXT;
-      g.createResult[h] = inst.next.xrCreateHandTrackerEXT(s.handle, &info, &g.created[h]);
-      if (g.createResult[h] != XR_SUCCESS) {
-        g.created[h] = XR_NULL_HANDLE;
-        // Remembered for the session (planGather): a refusal is not retried every frame (each
-        // retry is an error line in the runtime's log).
-        SDFG_LOG_INFO(cmd,
-                      "the runtime refused a %s hand tracker (%d); that hand follows the "
-                      "controller",
-                      h == 0 ? "left" : "right", int(g.createResult[h]));
-      }
-      tracker = g.created[h];
+    if (p.actions) {
+      XrActionStateGetInfo get{XR_TYPE_ACTION_STATE_GET_INFO};
+      get.action = inst.squeezeAction;
+      get.subactionPath = inst.handPaths[h];
+      XrActionStateFloat state{XR_TYPE_ACTION_STATE_FLOAT};
+      g.squeezeActive[h] =
+          inst.next.xrGetActionStateFloat(s.handle, &get, &state) == XR_SUCCESS && state.isActive;
+      g.squeeze[h] =
+          g.squeezeActive[h] && std::isfinite(state.currentState) ? state.currentState : 0.0f;
     }
+    const XrHandTrackerEXT tracker =
+        p.createTracker[h] ? createInternalTracker(s, h, cmd) : p.trackers[h];
+    bool trackerActive = false;
     if (tracker != XR_NULL_HANDLE) {
       std::array<XrHandJointLocationEXT, XR_HAND_JOINT_COUNT_EXT> loc{};
       XrHandJointLocationsEXT locations{XR_TYPE_HAND_JOINT_LOCATIONS_EXT};
@@ -130,8 +192,11 @@ Gathered gather(SessionState& s, const Plan& p, const char* cmd) {
       XrHandJointsLocateInfoEXT info{XR_TYPE_HAND_JOINTS_LOCATE_INFO_EXT};
       info.baseSpace = p.local;
       info.time = p.time;
-      if (inst.next.xrLocateHandJointsEXT(tracker, &info, &locations) == XR_SUCCESS &&
-          locations.isActive) {
+      trackerActive = inst.next.xrLocateHandJointsEXT(tracker, &info, &locations) == XR_SUCCESS &&
+                      locations.isActive;
+      // A tracked hand with a joint the runtime does not vouch for takes no part this frame, and
+      // the app is shown the runtime's joints as they are (hands.cpp).
+      if (trackerActive && allJointsValid(loc)) {
         for (int j = 0; j < kJointCount; ++j) {
           g.joints[h][size_t(j)] = toPose(loc[size_t(j)].pose);
           g.radii[h][size_t(j)] = loc[size_t(j)].radius;
@@ -139,7 +204,9 @@ Gathered gather(SessionState& s, const Plan& p, const char* cmd) {
         g.trackedValid[h] = true;
       }
     }
-    if (!g.trackedValid[h]) g.grip[h] = locate(inst, p.grips[h], p.local, p.time);
+    // The controller drives a hand the runtime does not track now, never one it tracks with
+    // joints it marks invalid: the app draws that one from the runtime's joints.
+    if (!trackerActive && p.actions) g.grip[h] = locate(inst, p.grips[h], p.local, p.time);
   }
   g.spaces.reserve(p.spaces.size());
   for (XrSpace space : p.spaces) {
@@ -152,27 +219,6 @@ Gathered gather(SessionState& s, const Plan& p, const char* cmd) {
     g.spaces.push_back(f);
   }
   return g;
-}
-
-// Ends the plan's uses of spaces and stores the trackers made (`g` null: the gather failed
-// before it was done; a tracker it may have made is not known). Returns whether a space's last use
-// ended. The caller holds the lock.
-bool finishGather(SessionState& s, const Plan& p, const Gathered* g) {
-  bool released = false;
-  for (XrSpace space : p.spaces) {
-    auto use = s.spaces.find(key(space));
-    if (use != s.spaces.end() && --use->second.users == 0) released = true;
-  }
-  for (size_t h = 0; h < 2; ++h) {
-    if (!p.createTracker[h]) continue;
-    s.internalTrackerCreating[h] = false;
-    if (g == nullptr) continue;
-    if (g->created[h] != XR_NULL_HANDLE)
-      s.internalTrackers[h] = g->created[h];
-    else
-      s.internalTrackerRefused[h] = true;
-  }
-  return released;
 }
 
 // What the update found, logged after the unlock.
@@ -274,26 +320,15 @@ void publishShownHands(SessionState& s) {
 void syncGrasps(SessionState& s, const char* cmd) {
   const std::optional<Plan> plan = planGather(s);
   if (!plan) return;
-  std::optional<Gathered> gathered;
+  PlanClaims claims(s, *plan);
+  const Gathered gathered = gather(s, *plan, cmd);
   UpdateReport report;
-  bool released = false;
-  try {
-    gathered = gather(s, *plan, cmd);
-  } catch (...) {
-    // The spaces must be released whatever happened (an xrDestroySpace may be waiting).
-    {
-      std::lock_guard lock(s.mutex);
-      finishGather(s, *plan, nullptr);
-    }
-    s.spaceReleased.notify_all();
-    throw;
-  }
   {
     std::lock_guard lock(s.mutex);
-    released = finishGather(s, *plan, &*gathered);
-    if (s.grasp != nullptr) updateHands(s, *gathered, report);
+    claims.endLocked();
+    if (s.grasp != nullptr) updateHands(s, gathered, report);
   }
-  if (released) s.spaceReleased.notify_all();
+  claims.notify();
   logReport(*s.instance, report, cmd);
   pumpGpu(s, false);
 }

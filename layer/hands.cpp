@@ -5,6 +5,7 @@
 // never waits for the thread that updates the grasps.
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include "data_source.h"
 #include "intercepts.h"
@@ -153,9 +154,17 @@ XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT tracker,
     if (r != XR_SUCCESS || !locations->isActive) return r;
     try {
       const auto view = shownHand(*s, t->hand);
-      // Pass-through, untouched, unless a grasp is shown or its offset still blends out.
+      // Pass-through, untouched, unless a grasp is shown or its offset still blends out, and
+      // always where the runtime marks a joint's pose invalid: the layer draws only on a hand
+      // whose every joint the runtime vouches for (the grab update uses no other either).
       if (view == nullptr || !view->changesHand() || locations->jointLocations == nullptr ||
           locations->jointCount != XR_HAND_JOINT_COUNT_EXT)
+        return r;
+      const std::span<const XrHandJointLocationEXT> given(locations->jointLocations,
+                                                          XR_HAND_JOINT_COUNT_EXT);
+      if (!std::all_of(given.begin(), given.end(), [](const XrHandJointLocationEXT& l) {
+            return (l.locationFlags & kValidBits) == kValidBits;
+          }))
         return r;
       JointPoses joints;
       for (int j = 0; j < kJointCount; ++j) joints[j] = toPose(locations->jointLocations[j].pose);

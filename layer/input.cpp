@@ -1,9 +1,12 @@
 // The layer's own input: an action set with a squeeze value and a grip pose per hand, merged
 // into the app's suggested bindings, attached with the app's sets and synced with every app sync
 // (notes/openxr-layer.md section 12). Priority 0 and bindings added only to profiles the app
-// suggests, so the app's actions report exactly what they would without the layer.
+// suggests, so the app's actions report exactly what they would without the layer. The layer
+// never attaches its set alone unless configured to (attach_alone): an app may attach once per
+// session, at any time, and must not be refused because of the layer.
 #include <array>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 #include "intercepts.h"
@@ -84,10 +87,28 @@ void suggestOwnBindingsIfAlone(InstanceState& inst) {
   }
 }
 
-// The grip spaces and the LOCAL space the grab update works in, made on the runtime with no
-// lock held, then stored. Made once: a second caller (two attaches cannot both succeed) finds
-// them set and gives its own back.
-void createLayerSpaces(SessionState& s) {
+// Makes `make` a layer space of the session unless another thread stored one first (then its own
+// is given back). Made on the runtime with no lock held, then stored under it.
+template <class Make>
+void storeLayerSpace(SessionState& s, XrSpace SessionState::*field, Make make) {
+  {
+    std::lock_guard lock(s.mutex);
+    if (s.*field != XR_NULL_HANDLE) return;
+  }
+  XrSpace made = make();
+  if (made == XR_NULL_HANDLE) return;
+  {
+    std::lock_guard lock(s.mutex);
+    if (s.*field == XR_NULL_HANDLE) {
+      s.*field = made;
+      return;
+    }
+  }
+  s.instance->next.xrDestroySpace(made);
+}
+
+// The grip spaces of the layer's pose action, once its set is attached.
+void createGripSpaces(SessionState& s) {
   auto& next = s.instance->next;
   std::array<XrSpace, 2> grips{};
   for (size_t h = 0; h < 2; ++h) {
@@ -98,38 +119,64 @@ void createLayerSpaces(SessionState& s) {
     if (next.xrCreateActionSpace(s.handle, &spaceInfo, &grips[h]) != XR_SUCCESS)
       grips[h] = XR_NULL_HANDLE;
   }
-  XrSpace localSpace = XR_NULL_HANDLE;
-  XrReferenceSpaceCreateInfo local{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};
-  local.referenceSpaceType = XR_REFERENCE_SPACE_TYPE_LOCAL;
-  local.poseInReferenceSpace.orientation.w = 1.0f;
-  if (next.xrCreateReferenceSpace(s.handle, &local, &localSpace) != XR_SUCCESS)
-    localSpace = XR_NULL_HANDLE;
   bool stored = false;
   {
     std::lock_guard lock(s.mutex);
-    if (s.localSpace == XR_NULL_HANDLE && s.gripSpaces == std::array<XrSpace, 2>{}) {
+    if (s.gripSpaces == std::array<XrSpace, 2>{}) {
       s.gripSpaces = grips;
-      s.localSpace = localSpace;
       stored = true;
     }
   }
   if (stored) return;
-  for (XrSpace space : {grips[0], grips[1], localSpace})
+  for (XrSpace space : grips)
     if (space != XR_NULL_HANDLE) next.xrDestroySpace(space);
 }
 
-}  // namespace
+// The LOCAL space the grab update works in. A reference space needs no action set, so every
+// session gets one at its first frame: an app that tracks hands through the runtime and has no
+// actions grasps too, and one that attaches late has it ready.
+void ensureLocalSpace(SessionState& s) {
+  storeLayerSpace(s, &SessionState::localSpace, [&] {
+    XrReferenceSpaceCreateInfo local{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};
+    local.referenceSpaceType = XR_REFERENCE_SPACE_TYPE_LOCAL;
+    local.poseInReferenceSpace.orientation.w = 1.0f;
+    XrSpace space = XR_NULL_HANDLE;
+    if (s.instance->next.xrCreateReferenceSpace(s.handle, &local, &space) != XR_SUCCESS)
+      return XrSpace(XR_NULL_HANDLE);
+    return space;
+  });
+}
 
-void selfAttachIfNeeded(SessionState& s) {
+// Once the layer's set is attached (with the app's, or alone).
+void createLayerSpaces(SessionState& s) {
+  ensureLocalSpace(s);
+  createGripSpaces(s);
+}
+
+// An app that made synthesized trackers and has attached no action sets yet: the layer waits for
+// its attach (its set goes with the app's) unless attach_alone is set. Says so once.
+void attachAloneIfAllowed(SessionState& s) {
   constexpr const char* cmd = "xrWaitFrame";
   InstanceState& inst = *s.instance;
+  bool sayWaiting = false;
   {
     // Claimed under the lock, attached without it.
     std::lock_guard lock(s.mutex);
     if (s.attached || s.appAttached || s.selfAttachFailed || s.selfAttaching ||
         s.synthesizedTrackers == 0 || inst.actionSet == XR_NULL_HANDLE)
       return;
-    s.selfAttaching = true;
+    if (inst.config.attachAlone)
+      s.selfAttaching = true;
+    else
+      sayWaiting = !std::exchange(s.waitingForAttachLogged, true);
+  }
+  if (!inst.config.attachAlone) {
+    if (sayWaiting)
+      SDFG_LOG_INFO(cmd,
+                    "the app has attached no action sets yet: hands synthesized from the "
+                    "controllers stay inactive until it does (attach_alone = true attaches the "
+                    "layer's set alone, after which the app can attach none)");
+    return;
   }
   suggestOwnBindingsIfAlone(inst);
   XrSessionActionSetsAttachInfo info{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
@@ -152,22 +199,38 @@ void selfAttachIfNeeded(SessionState& s) {
                   int(r));
   else
     SDFG_LOG_INFO(cmd,
-                  "the app attached no action sets: the layer attached its own so that "
-                  "synthesized hands follow the controllers (a later app attach is refused)");
+                  "attach_alone: the app attached no action sets, so the layer attached its own "
+                  "for synthesized hands to follow the controllers (a later app attach is "
+                  "refused)");
 }
 
-void syncOwnActions(SessionState& s) {
+}  // namespace
+
+void updateInputAtFrame(SessionState& s) {
+  ensureLocalSpace(s);
+  attachAloneIfAllowed(s);
+  bool attached = false;
+  bool selfAttached = false;
   {
     std::lock_guard lock(s.mutex);
-    if (!s.selfAttached) return;
+    attached = s.attached;
+    selfAttached = s.selfAttached;
   }
-  InstanceState& inst = *s.instance;
-  XrActiveActionSet active{inst.actionSet, XR_NULL_PATH};
-  XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
-  sync.countActiveActionSets = 1;
-  sync.activeActionSets = &active;
-  const XrResult r = inst.next.xrSyncActions(s.handle, &sync);
-  if (r == XR_SUCCESS || r == XR_SESSION_NOT_FOCUSED) syncGrasps(s, "xrWaitFrame");
+  if (selfAttached) {
+    InstanceState& inst = *s.instance;
+    XrActiveActionSet active{inst.actionSet, XR_NULL_PATH};
+    XrActionsSyncInfo sync{XR_TYPE_ACTIONS_SYNC_INFO};
+    sync.countActiveActionSets = 1;
+    sync.activeActionSets = &active;
+    const XrResult r = inst.next.xrSyncActions(s.handle, &sync);
+    if (r == XR_SUCCESS || r == XR_SESSION_NOT_FOCUSED) syncGrasps(s, "xrWaitFrame");
+  } else if (!attached) {
+    // The layer's set is not attached (the app has attached none yet, or the runtime refused the
+    // layer's): the update runs once a frame on what the runtime gives without actions, the
+    // hands it tracks, so the outer hand and grabs by closing the hand work.
+    syncGrasps(s, "xrWaitFrame");
+  }
+  // Attached with the app's set: the app's xrSyncActions runs the update.
 }
 
 void createLayerActions(InstanceState& instance) {
@@ -268,9 +331,17 @@ XrResult XRAPI_CALL SdfgXrAttachSessionActionSets(XrSession session,
     std::lock_guard lock(s->mutex);
     selfAttached = s->selfAttached;
   }
+  if (selfAttached) {
+    const XrResult r = next.xrAttachSessionActionSets(session, info);
+    if (r == XR_ERROR_ACTIONSETS_ALREADY_ATTACHED)
+      SDFG_LOG_WARN(cmd,
+                    "refused because the layer attached its own set at the first frame "
+                    "(attach_alone = true); set attach_alone = false for this app");
+    return r;
+  }
   if (inst.actionSet == XR_NULL_HANDLE || info == nullptr ||
       info->type != XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO || info->countActionSets == 0 ||
-      info->actionSets == nullptr || selfAttached)
+      info->actionSets == nullptr)
     return next.xrAttachSessionActionSets(session, info);
   suggestOwnBindingsIfAlone(inst);
   std::vector<XrActionSet> sets(info->actionSets, info->actionSets + info->countActionSets);
@@ -322,7 +393,25 @@ XrResult XRAPI_CALL SdfgXrSyncActions(XrSession session, const XrActionsSyncInfo
   XrActionsSyncInfo copy = *info;
   copy.countActiveActionSets = uint32_t(active.size());
   copy.activeActionSets = active.data();
-  const XrResult r = inst.next.xrSyncActions(session, &copy);
+  XrResult r = inst.next.xrSyncActions(session, &copy);
+  if (XR_FAILED(r)) {
+    // Never fail the app's call because of the layer's set: asked again as the app made it, the
+    // runtime's answer to that is the app's. The layer's input is not read this frame.
+    const XrResult own = inst.next.xrSyncActions(session, info);
+    if (XR_SUCCEEDED(own)) {
+      bool first = false;
+      {
+        std::lock_guard lock(s->mutex);
+        first = !std::exchange(s->syncRefusedLogged, true);
+      }
+      if (first)
+        SDFG_LOG_WARN(cmd,
+                      "the runtime refused the sync with the layer's action set (%d); synced "
+                      "as the app asked, the layer's squeeze and grip are not read",
+                      int(r));
+    }
+    return own;
+  }
   if (r == XR_SUCCESS || r == XR_SESSION_NOT_FOCUSED) {
     // A failure in the layer's own work never changes the app's result. Builds the update
     // records go to a queue of the layer's own at once (the pump in syncGrasps); the app's queue

@@ -1,6 +1,8 @@
 // Sessions and what the layer tracks on them: system properties (hand tracking it provides),
 // session create/destroy, the predicted display time, and the app's spaces.
 #include <algorithm>
+#include <chrono>
+#include <optional>
 
 #include "intercepts.h"
 #include "log.h"
@@ -10,6 +12,10 @@
 
 namespace sdfg::layer {
 namespace {
+
+// How long xrDestroySpace waits for the layer's own use of the space (one xrLocateSpace of the
+// runtime) to end.
+constexpr std::chrono::seconds kSpaceUseWait{5};
 
 std::shared_ptr<InstanceState> instanceOf(XrInstance handle) {
   return instances().find(key(handle));
@@ -243,19 +249,16 @@ XrResult XRAPI_CALL SdfgXrWaitFrame(XrSession session, const XrFrameWaitInfo* in
       XrTime time = frameState->predictedDisplayTime;
       if (time <= 0) time = layerClockTime(*s->instance);
       bool sayNoTime = false;
-      bool selfAttached = false;
       {
         std::lock_guard lock(s->mutex);
         s->predictedTime = time;
         sayNoTime = time <= 0 && !std::exchange(s->noTimeLogged, true);
-        selfAttached = s->selfAttached;
       }
       if (sayNoTime)
         SDFG_LOG_WARN(cmd,
                       "the runtime predicts no display time and offers no "
                       "XR_KHR_convert_timespec_time: no grasps in this session");
-      if (!selfAttached) selfAttachIfNeeded(*s);
-      syncOwnActions(*s);
+      updateInputAtFrame(*s);
     } catch (...) {
       SDFG_LOG_WARN(cmd, "frame update failed; hands pass through this frame");
     }
@@ -297,14 +300,17 @@ XrResult XRAPI_CALL SdfgXrDestroySpace(XrSpace space) {
   // No new use of the space starts once it is dying; this call waits for the uses in flight (a
   // grab update on another thread locating a target placed in it: one xrLocateSpace), so the
   // layer never passes the space down after the app destroyed it. Targets placed in it stop
-  // taking part until they are placed again, and a hand holding one lets go.
+  // taking part until they are placed again, and a hand holding one lets go. The wait has a
+  // bound: a runtime whose xrLocateSpace does not return must not hang the app's destroy too.
   std::vector<uint64_t> unplaced;
+  std::optional<SpaceUse> record;
+  bool waitedOut = false;
   {
     std::unique_lock lock(s->mutex);
     auto use = s->spaces.find(key(space));
     if (use != s->spaces.end()) {
       use->second.dying = true;
-      s->spaceReleased.wait(lock, [&] {
+      waitedOut = !s->spaceReleased.wait_for(lock, kSpaceUseWait, [&] {
         auto u = s->spaces.find(key(space));
         return u == s->spaces.end() || u->second.users == 0;
       });
@@ -326,21 +332,35 @@ XrResult XRAPI_CALL SdfgXrDestroySpace(XrSpace space) {
       }
       publishShownHands(*s);
     }
+    // Forgotten before the call down: once the runtime has destroyed the space, a space another
+    // thread creates may get the same handle, and must neither find this record nor lose its own.
+    if (auto u = s->spaces.find(key(space)); u != s->spaces.end()) {
+      record = u->second;
+      s->spaces.erase(u);
+    }
   }
+  spaceOwners().erase(key(space));
+  if (waitedOut)
+    SDFG_LOG_WARN(cmd,
+                  "the layer's xrLocateSpace on this space did not return within %lld s; the "
+                  "space is destroyed anyway",
+                  static_cast<long long>(kSpaceUseWait.count()));
   if (!unplaced.empty())
     SDFG_LOG_INFO(cmd,
                   "%zu grasp target(s) were placed in this space; they take no part until placed "
                   "again",
                   unplaced.size());
   const XrResult r = s->instance->next.xrDestroySpace(space);
-  {
-    std::lock_guard lock(s->mutex);
-    if (XR_SUCCEEDED(r))
-      s->spaces.erase(key(space));
-    else if (auto use = s->spaces.find(key(space)); use != s->spaces.end())
-      use->second.dying = false;  // still alive: it may be used again (its targets stay unplaced)
+  if (XR_FAILED(r) && record) {
+    // Still alive: it may be used again (its targets stay unplaced).
+    record->dying = false;
+    record->users = 0;
+    {
+      std::lock_guard lock(s->mutex);
+      s->spaces.emplace(key(space), *record);
+    }
+    spaceOwners().insert(key(space), s);
   }
-  if (XR_SUCCEEDED(r)) spaceOwners().erase(key(space));
   return r;
   SDFG_ENTRY_END(cmd)
 }

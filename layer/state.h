@@ -142,12 +142,14 @@ struct SessionState {
   // the layer never hands a destroyed space to the runtime.
   std::map<uint64_t, SpaceUse> spaces;
   std::condition_variable spaceReleased;
-  bool attached = false;  // the layer's action set is attached with the app's
-  // The app attached no action sets but located synthesized hands: the layer attached its set
-  // alone (input.cpp selfAttachIfNeeded) and syncs it in xrWaitFrame; tried once.
+  bool attached = false;  // the layer's action set is attached (with the app's, or alone)
+  // attach_alone: the app attached no action sets by a frame with synthesized trackers, so the
+  // layer attached its set alone (input.cpp) and syncs it in xrWaitFrame; tried once.
   bool selfAttached = false;
   bool selfAttaching = false;  // a thread is attaching it now (without the lock)
   bool selfAttachFailed = false;
+  bool waitingForAttachLogged = false;  // said once: synthesized hands wait for the app's attach
+  bool syncRefusedLogged = false;       // said once: a sync with the layer's set was refused
   bool appAttached = false;     // the app's own sets are attached (with or without the layer's)
   int synthesizedTrackers = 0;  // live synthesized trackers the app made on this session
   // The runtime refused the layer's own hand tracker for a hand: remembered, never retried.
@@ -327,20 +329,20 @@ T* findInChain(Base* chain, XrStructureType type) {
 GraspSettings settingsFromConfig(const Config& config);
 std::string resolveSolverName(const std::string& name);
 
-// grasp_frame.cpp: the layer's grab update for both hands after a sync of its action set (the
-// app's xrSyncActions, or xrWaitFrame for a session the layer attached alone): gathers the
-// squeeze and the hand and target poses from the runtime with no lock held, then hands them to
-// the engine under the session's lock and publishes what each hand shows. Takes no lock on
-// entry.
+// grasp_frame.cpp: the layer's grab update for both hands: after a sync of its action set (the
+// app's xrSyncActions, or xrWaitFrame for a session the layer attached alone), or in xrWaitFrame
+// without actions while its set is not attached. Gathers the squeeze (when the set is attached)
+// and the hand and target poses from the runtime with no lock held, then hands them to the engine
+// under the session's lock and publishes what each hand shows. Takes no lock on entry.
 void syncGrasps(SessionState& session, const char* cmd);
 // Publishes what each hand shows now (the caller holds session.mutex): after each grab update,
 // and when a call lets a hand go at once (its target or the target's space destroyed).
 void publishShownHands(SessionState& session);
-// input.cpp, for a session whose app attached no action sets but made synthesized trackers:
-// attaches the layer's set alone (once), and syncs it plus the grab update each frame. Both
-// take no lock on entry.
-void selfAttachIfNeeded(SessionState& session);
-void syncOwnActions(SessionState& session);
+// input.cpp, from xrWaitFrame: makes the layer's LOCAL space (every session, at its first frame),
+// attaches the layer's set alone where attach_alone allows it, and runs the frame's grab update
+// where no app sync will (a set the layer attached alone, or none attached). Takes no lock on
+// entry.
+void updateInputAtFrame(SessionState& session);
 
 // vulkan.cpp: the Vulkan SDF backend for a session created with a Vulkan binding (null when the
 // layer is built without it, the config says gpu = false, or the device cannot be used; the

@@ -131,13 +131,16 @@ TEST_CASE("A runtime's refusal of the layer's own hand trackers is not retried e
   CHECK(validationLog().empty());
 }
 
-TEST_CASE("An app that attaches no actions still gets active synthesized hands",
+TEST_CASE("An app that attaches no actions gets active synthesized hands with attach_alone",
           "[layer][synthesis]") {
-  // The CTS's "Query joint locations": trackers and a frame loop, no action sets at all.
+  // The CTS's "Query joint locations": trackers and a frame loop, no action sets at all. By
+  // default the layer waits for an attach that never comes (layer_input.tests.cpp); configured to,
+  // it attaches its own set alone.
   const std::string handTracking = GENERATE(std::string("absent"), std::string("0"));
   CAPTURE(handTracking);
   XrEnv env;
   env.handTracking = handTracking;
+  env.extra = {{"SDFG_AUTOGRASP_ATTACH_ALONE", "true"}};
   env.script = gripLine(0, "right", kGrip) + gripLine(0, "left", kGrip);
   applyEnv(env);
   AppOptions options;

@@ -326,6 +326,10 @@ XrResult syncActions(XrSession handle, const XrActionsSyncInfo* info) {
   MOCK_VERIFY_TYPE(cmd, info, XR_TYPE_ACTIONS_SYNC_INFO);
   if (info->countActiveActionSets > 0) MOCK_VERIFY_NOT_NULL(cmd, info->activeActionSets);
   Instance& instance = *session->instance;
+  // A runtime that takes one active set at a time (the layer must then sync the app's alone).
+  if (instance.options.fault == "sync_one_set" && info->countActiveActionSets > 1)
+    return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "fault sync_one_set: %u active sets",
+                info->countActiveActionSets);
   // Per attached set: which slots the app activated (bit 0 left, bit 1 right).
   std::map<const ActionSet*, int> activeSlots;
   for (uint32_t i = 0; i < info->countActiveActionSets; ++i) {

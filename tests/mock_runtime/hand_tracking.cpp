@@ -155,6 +155,12 @@ XrResult locateHandJoints(XrHandTrackerEXT handle, const XrHandJointsLocateInfoE
       l.radius = 0;
       l.locationFlags = 0;
     }
+    // A runtime that loses one joint of a tracked hand: its pose not valid (and garbage).
+    if (active && j == XR_HAND_JOINT_LITTLE_TIP_EXT &&
+        session.instance->options.fault == "invalid_joint") {
+      l.locationFlags = 0;
+      l.pose.orientation = {0, 0, 0, 0};
+    }
     if (velocities != nullptr) {
       velocities->jointVelocities[j].velocityFlags = 0;  // the script has no velocities
       velocities->jointVelocities[j].linearVelocity = {0, 0, 0};

@@ -155,6 +155,37 @@ int main(void) {
   XrHandTrackerEXT rightHand = XR_NULL_HANDLE;
   CHECK_XR(g.createHandTracker(session, &htci, &rightHand));
 
+  // 2b. The app's own input, as every app has: an action set, attached once and synced every
+  //     frame. The layer's own set (the controller's squeeze and grip) goes with it, and its grab
+  //     update runs in that sync. The layer never attaches a set alone, since the app may attach
+  //     only once per session: until the app attaches, no controller can be read and hands
+  //     synthesized from one are not active.
+  XrActionSetCreateInfo asci = {.type = XR_TYPE_ACTION_SET_CREATE_INFO};
+  strcpy(asci.actionSetName, "grasp_scene");
+  strcpy(asci.localizedActionSetName, "Grasp scene");
+  XrActionSet actionSet = XR_NULL_HANDLE;
+  CHECK_XR(xrCreateActionSet(instance, &asci, &actionSet));
+  XrActionCreateInfo aci = {.type = XR_TYPE_ACTION_CREATE_INFO};
+  aci.actionType = XR_ACTION_TYPE_BOOLEAN_INPUT;
+  strcpy(aci.actionName, "menu");
+  strcpy(aci.localizedActionName, "Menu");
+  XrAction menu = XR_NULL_HANDLE;
+  CHECK_XR(xrCreateAction(actionSet, &aci, &menu));
+  XrPath profile = XR_NULL_PATH, menuClick = XR_NULL_PATH;
+  CHECK_XR(xrStringToPath(instance, "/interaction_profiles/oculus/touch_controller", &profile));
+  CHECK_XR(xrStringToPath(instance, "/user/hand/left/input/menu/click", &menuClick));
+  XrActionSuggestedBinding binding = {menu, menuClick};
+  XrInteractionProfileSuggestedBinding suggested = {
+      .type = XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+  suggested.interactionProfile = profile;
+  suggested.countSuggestedBindings = 1;
+  suggested.suggestedBindings = &binding;
+  CHECK_XR(xrSuggestInteractionProfileBindings(instance, &suggested));
+  XrSessionActionSetsAttachInfo attach = {.type = XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
+  attach.countActionSets = 1;
+  attach.actionSets = &actionSet;
+  CHECK_XR(xrAttachSessionActionSets(session, &attach));
+
   // 3. The scene, in LOCAL (metres): a table top 40 cm below the head whose hands only stop on
   //    it; a cup standing on it; a block beside the cup, 16 cm away.
   const char* names[3] = {"table", "cup", "block"};
@@ -209,6 +240,11 @@ int main(void) {
     waitForNextFrame();
     CHECK_XR(xrWaitFrame(session, NULL, &fs));
     CHECK_XR(xrBeginFrame(session, NULL));
+    XrActiveActionSet active = {actionSet, XR_NULL_PATH};
+    XrActionsSyncInfo sync = {.type = XR_TYPE_ACTIONS_SYNC_INFO};
+    sync.countActiveActionSets = 1;
+    sync.activeActionSets = &active;
+    CHECK_XR(xrSyncActions(session, &sync));  // XR_SESSION_NOT_FOCUSED is a success
 
     // The hand as the app draws it: the ordinary joints, closed onto the cup once grasped.
     XrHandJointLocationEXT joints[XR_HAND_JOINT_COUNT_EXT];
@@ -255,6 +291,7 @@ int main(void) {
   CHECK_XR(g.destroyHandTracker(rightHand));
   CHECK_XR(xrDestroySpace(local));
   CHECK_XR(xrDestroySession(session));
+  CHECK_XR(xrDestroyActionSet(actionSet));
   CHECK_XR(xrDestroyInstance(instance));
   // The example's own check (ctest runs it): the hand took the cup at some point.
   printf(heldCup ? "grasp_scene: the right hand took the cup\n"

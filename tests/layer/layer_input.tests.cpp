@@ -306,3 +306,72 @@ TEST_CASE("A tracked hand with a joint the runtime marks invalid is shown as the
     CHECK(shown[k] == tracked[k]);
   }
 }
+
+TEST_CASE("Any runtime call of the grab update may fail: the app's calls and destroys go on",
+          "[layer][input]") {
+  // Each call the layer makes in its grab update, refused by the runtime every time.
+  const std::string call =
+      GENERATE(std::string("xrGetActionStateFloat"), std::string("xrLocateSpace"),
+               std::string("xrLocateHandJointsEXT"), std::string("xrCreateHandTrackerEXT"),
+               std::string("xrCreateActionSpace"));
+  const std::string handTracking = GENERATE(std::string("1"), std::string("absent"));
+  CAPTURE(call, handTracking);
+  XrEnv env;
+  env.handTracking = handTracking;
+  env.extra = {{"SDFG_MOCK_FAULT", "fail:" + call}};
+  env.script =
+      gripLine(0, "right", kGrip) + squeezeLine(0, "right", 0.0f) + squeezeLine(4, "right", 1.0f);
+  applyEnv(env);
+  App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}});
+  REQUIRE(app.ok());
+  Ext ext(app);
+  XrHandTrackerCreateInfoEXT tci{XR_TYPE_HAND_TRACKER_CREATE_INFO_EXT};
+  tci.hand = XR_HAND_RIGHT_EXT;
+  tci.handJointSet = XR_HAND_JOINT_SET_DEFAULT_EXT;
+  XrHandTrackerEXT tracker = XR_NULL_HANDLE;
+  // The runtime's own trackers are refused with xrCreateHandTrackerEXT failing: as without the
+  // layer, the app has none then.
+  const XrResult made = ext.createTracker(app.session, &tci, &tracker);
+  CHECK((made == XR_SUCCESS || (call == "xrCreateHandTrackerEXT" && handTracking == "1" &&
+                                made == XR_ERROR_RUNTIME_FAILURE)));
+  // A sphere in a space of its own, under the hand.
+  XrReferenceSpaceCreateInfo rs{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};
+  rs.referenceSpaceType = XR_REFERENCE_SPACE_TYPE_LOCAL;
+  rs.poseInReferenceSpace.orientation.w = 1;
+  XrSpace space = XR_NULL_HANDLE;
+  REQUIRE(xrCreateReferenceSpace(app.session, &rs, &space) == XR_SUCCESS);
+  const XrVector3f centre = boxCentreInLocal(kGrip, /*right=*/true);
+  const TestMesh sphere = makeIcosphere(0.04f, 3);
+  XrGraspTargetVerticesSDFG v{XR_TYPE_GRASP_TARGET_VERTICES_SDFG};
+  v.vertexCount = uint32_t(sphere.vertices.size());
+  v.vertices = sphere.vertices.data();
+  v.indexCount = uint32_t(sphere.indices.size());
+  v.indices = sphere.indices.data();
+  XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &v};
+  ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, space, {{0, 0, 0, 1}, centre}};
+  XrGraspTargetSDFG target = XR_NULL_HANDLE;
+  REQUIRE(ext.create(app.session, &ci, &target) == XR_SUCCESS);
+  int located = 0;
+  const bool ran = pacedUntil(app, [&] {
+    if (tracker != XR_NULL_HANDLE && app.lastTime > 0) {
+      // The runtime's answer where the runtime answers (its tracker with its locate failing).
+      Joints j;
+      const bool refused = call == "xrLocateHandJointsEXT" && handTracking == "1";
+      CHECK(locateJoints(app, tracker, j) == (refused ? XR_ERROR_RUNTIME_FAILURE : XR_SUCCESS));
+    }
+    return ++located >= 40;
+  });
+  CHECK(ran);
+  CHECK(app.framesEnded >= 39u);
+  CHECK(app.lastSync == XR_SUCCESS);
+  XrGraspStateSDFG state{XR_TYPE_GRASP_STATE_SDFG};
+  XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
+  CHECK(ext.state(app.session, &gi, &state) == XR_SUCCESS);
+  // The destroys the layer waits in return, and go down.
+  CHECK(xrDestroySpace(space) == XR_SUCCESS);
+  CHECK(ext.destroy(target) == XR_SUCCESS);
+  app.frames(3);
+  CHECK(mockStats(app).framesEnded == app.framesEnded);
+  app.destroySession();
+  CHECK(validationLog().empty());
+}

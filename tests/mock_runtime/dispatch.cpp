@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <new>
+#include <string>
+#include <string_view>
 #include <thread>
 
 #include "entry_points.h"
@@ -35,6 +37,7 @@ struct Entry<Impl> {
   }
   static XrResult XRAPI_CALL call(A... args) noexcept {
     try {
+      if (const XrResult failure = gate().failure(); failure != XR_SUCCESS) return failure;
       gate().pass();  // before the lock: a held call does not hold up the other commands
       std::lock_guard<std::mutex> lock(globalMutex());
       return Impl(args...);
@@ -194,6 +197,25 @@ CallGate* findGate(const char* command) {
     if (std::strcmp(c.name, command) == 0) return c.gate;
   }
   return nullptr;
+}
+
+bool setCallFailures(const std::string& fault) {
+  for (const Command& c : commands())
+    if (c.gate != nullptr) c.gate->setFailure(XR_SUCCESS);
+  constexpr std::string_view kPrefix = "fail:";
+  if (fault.rfind(kPrefix, 0) != 0) return true;
+  bool known = true;
+  std::string_view rest = std::string_view(fault).substr(kPrefix.size());
+  while (!rest.empty()) {
+    const size_t comma = rest.find(',');
+    const std::string name(rest.substr(0, comma));
+    if (CallGate* gate = findGate(name.c_str()); gate != nullptr)
+      gate->setFailure(XR_ERROR_RUNTIME_FAILURE);
+    else
+      known = false;
+    rest = comma == std::string_view::npos ? std::string_view() : rest.substr(comma + 1);
+  }
+  return known;
 }
 
 void CallGate::pass() {

@@ -129,6 +129,8 @@ static void applyOptions(Instance& instance) {
   if (const char* v = std::getenv(SDFG_MOCK_ENV_CAPTURE)) o.capturePath = v;
   if (const char* v = std::getenv(SDFG_MOCK_ENV_REPORT)) o.reportPath = v;
   if (const char* v = std::getenv(SDFG_MOCK_ENV_FAULT)) o.fault = v;
+  if (!setCallFailures(o.fault))
+    std::fprintf(stderr, "mock runtime: %s names an unknown command\n", o.fault.c_str());
   o.capture = !o.capturePath.empty() || !o.reportPath.empty();
   const Script& s = instance.script;
   if (auto d = s.directive("end_after_frames"))

@@ -270,8 +270,13 @@ class CallGate {
   void pass();
   void set(bool hold, uint32_t delayMicroseconds);
   void stats(uint32_t& waiting, uint64_t& passed) const;
+  // SDFG_MOCK_FAULT=fail:<command>[,<command>...]: every call of the command returns `result`
+  // without doing anything (XR_SUCCESS: as normal).
+  void setFailure(XrResult result) { failure_.store(result, std::memory_order_release); }
+  XrResult failure() const { return failure_.load(std::memory_order_acquire); }
 
  private:
+  std::atomic<XrResult> failure_{XR_SUCCESS};
   std::atomic<bool> active_{false};
   mutable std::mutex mutex_;
   std::condition_variable opened_;
@@ -283,6 +288,9 @@ class CallGate {
 
 // The gate of a command by name (xrGetActionStateFloat...); null for an unknown name.
 CallGate* findGate(const char* command);
+// Sets every command's failure from an SDFG_MOCK_FAULT value ("fail:xrLocateSpace,..."; any other
+// value clears them all). False when it names a command the runtime does not have.
+bool setCallFailures(const std::string& fault);
 
 // ---- shared helpers ------------------------------------------------------------------------
 

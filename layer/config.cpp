@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "platform.h"
+#include "test_fault.h"
 
 namespace sdfg::layer {
 namespace {
@@ -51,7 +52,6 @@ const char* const kKeys[] = {"log_level",
                              "approach_max_angle",
                              "offset_blend_time",
                              "build_time_limit_ms",
-                             "test_layer_fault",
                              "outer_hand",
                              "outer_release_distance",
                              "outer_blend_time"};
@@ -119,16 +119,12 @@ bool applyConfigValue(Config& config, const std::string& key, const std::string&
     ok = parseFloat(value, 0.01f, 1.0f, c.outerReleaseDistance);
   } else if (key == "outer_blend_time") {
     ok = parseFloat(value, 0.0f, 2.0f, c.outerBlendTime);
-  } else if (key == "test_layer_fault") {
-    ok = value == "none" || value == "after_create_instance" || value == "after_create_session" ||
-         value == "after_create_space" || value == "after_create_tracker";
-    c.testLayerFault = value;
   } else if (key == "test_gpu_fault") {
     ok = value == "none" || value == "lost_at_submit" || value == "lost_at_poll" ||
          value == "never_ready" || value == "stuck_reads_once";
     c.testGpuFault = value;
-  } else {
-    ok = false;
+  } else if (!applyTestFaultKey(c, key, value, ok)) {
+    ok = false;  // unknown; test_layer_fault too, outside the layer's test build (test_fault.h)
   }
   if (ok) config = c;
   return ok;
@@ -158,7 +154,7 @@ Config loadConfig() {
       }
     }
   }
-  for (const char* key : kKeys) {
+  const auto fromEnvironment = [&config](const char* key) {
     std::string name = "SDFG_AUTOGRASP_";
     for (const char* p = key; *p != '\0'; ++p)
       name += char(std::toupper(static_cast<unsigned char>(*p)));
@@ -166,7 +162,9 @@ Config loadConfig() {
       if (!applyConfigValue(config, key, value))
         SDFG_LOG_WARN("config", "ignored %s=%s (bad value)", name.c_str(), value);
     }
-  }
+  };
+  for (const char* key : kKeys) fromEnvironment(key);
+  if (const char* key = testFaultKey(); key != nullptr) fromEnvironment(key);
   return config;
 }
 

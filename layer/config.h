@@ -43,8 +43,9 @@ struct Config {
   // never_ready (the GPU path never finishes preparing, as if the driver compiled forever),
   // stuck_reads_once (the first removal of a buffer target finds the GPU still reading it)
   std::string testGpuFault = "none";
-  // test_layer_fault: none, or the point after a successful call down where the layer throws
-  // (test_fault.h), to check that it gives back what the runtime made.
+  // test_layer_fault (the layer's test build only: test_fault.h): none, or the point after a
+  // successful call down where the layer throws, to check that it gives back what the runtime
+  // made. Always none in the shipped library.
   std::string testLayerFault = "none";
   std::string configPath;  // the file that was read, empty when none
   // Never inside (docs/layer.md, "The hand's clearance"): clear_hand, clear_bound (metres),

@@ -8,6 +8,14 @@ sdfg_layer_manifest(${CMAKE_CURRENT_BINARY_DIR}/XrApiLayer_sdfg_autograsp.json
 set(SDFG_LAYER_IMPLICIT_JSON ${CMAKE_CURRENT_BINARY_DIR}/XrApiLayer_sdfg_autograsp.json
   PARENT_SCOPE)
 set(SDFG_LAYER_DISABLE_ENV ${SDFG_LAYER_DISABLE_ENV} PARENT_SCOPE)
+if(TARGET sdfg_layer_test_faults)
+  # The layer's test build (test_fault.h), beside it, for the loader tests under Wine; not
+  # installed.
+  sdfg_layer_manifest(${CMAKE_CURRENT_BINARY_DIR}/XrApiLayer_sdfg_autograsp_test_faults.json
+    "./$<TARGET_FILE_NAME:sdfg_layer_test_faults>" TRUE)
+  set(SDFG_LAYER_TEST_IMPLICIT_JSON
+    ${CMAKE_CURRENT_BINARY_DIR}/XrApiLayer_sdfg_autograsp_test_faults.json PARENT_SCOPE)
+endif()
 install(TARGETS sdfg_layer RUNTIME DESTINATION . LIBRARY DESTINATION .)
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/XrApiLayer_sdfg_autograsp.json DESTINATION .)
 install(FILES ${PROJECT_SOURCE_DIR}/scripts/windows/install-layer.bat

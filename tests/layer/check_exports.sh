@@ -2,9 +2,12 @@
 # Checks the built layer library: its only exported symbol is xrNegotiateLoaderApiLayerInterface,
 # it does not link the OpenXR loader, its file name follows the Khronos pattern, and it needs no
 # library beyond the C and C++ runtimes (an implicit layer is loaded into every OpenXR app: no
-# physics engine, mesh importer or evaluator may ride along with it).
+# physics engine, mesh importer or evaluator may ride along with it). And it has no test fault
+# (check_no_test_fault.sh, which is shown the layer's test build too when that is given).
+#   check_exports.sh LIBRARY [TEST_BUILD]
 set -euo pipefail
 lib="$1"
+test_build="${2:-}"
 fail=0
 case "$(basename "$lib")" in
   libXrApiLayer_*.so) ;;
@@ -32,5 +35,6 @@ done
 if nm -D --undefined-only "$lib" | awk '{ print $2 }' | grep -q '^xr'; then
   echo "FAIL: the layer imports xr* symbols"; fail=1
 fi
+bash "$(dirname "${BASH_SOURCE[0]}")/check_no_test_fault.sh" "$lib" ${test_build:+"$test_build"} || fail=1
 [ "$fail" = 0 ] && echo PASS
 exit "$fail"

@@ -1,12 +1,19 @@
 // The layer's configuration keys (layer/config.h): every key takes a good value into its field
-// and refuses a bad one, and a refused value leaves the whole configuration as it was.
+// and refuses a bad one, and a refused value leaves the whole configuration as it was. Built
+// twice (tests/CMakeLists.txt): with the layer's test build's key test_layer_fault
+// (SDFG_LAYER_TEST_FAULTS=1), and as shipped, without it.
 #include <catch2/catch.hpp>
 
 #include <cctype>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
+#include <unistd.h>
+
 #include "config.h"
+#include "test_fault.h"
 
 using sdfg::layer::applyConfigValue;
 using sdfg::layer::Config;
@@ -51,8 +58,10 @@ const KeyCase kKeys[] = {
     {"extra_queue", "off", [](const Config& c) { return !c.extraQueue; }, "2"},
     {"test_gpu_fault", "lost_at_poll",
      [](const Config& c) { return c.testGpuFault == "lost_at_poll"; }, "crash"},
+#if SDFG_LAYER_TEST_FAULTS  // the layer's test build alone (test_fault.h)
     {"test_layer_fault", "after_create_session",
      [](const Config& c) { return c.testLayerFault == "after_create_session"; }, "after_lunch"},
+#endif
     {"clear_hand", "off", [](const Config& c) { return !c.clearHand; }, "x"},
     {"clear_bound", "0.05", [](const Config& c) { return c.clearBound == 0.05f; }, "0.3"},
     {"approach", "on", [](const Config& c) { return c.approach; }, "x"},
@@ -132,4 +141,37 @@ TEST_CASE("exact_check and sdf_far_band are parsed and range-checked", "[layer][
     CHECK(c.sdfFarBand == 3.5f);
   }
   CHECK_FALSE(applyConfigValue(c, "no_such_key", "1"));
+}
+
+TEST_CASE("test_layer_fault is a key of the layer's test build alone", "[layer][config]") {
+  // From a config file, from the environment, and applied directly.
+  namespace fs = std::filesystem;
+  const fs::path home = fs::temp_directory_path() / ("sdfg-config-" + std::to_string(getpid()));
+  fs::create_directories(home / "sdfg-autograsp");
+  std::ofstream(home / "sdfg-autograsp" / "config") << "test_layer_fault = after_create_space\n";
+  setenv("XDG_CONFIG_HOME", home.c_str(), 1);
+  const Config fromFile = sdfg::layer::loadConfig();
+  fs::remove_all(home);
+  setenv("XDG_CONFIG_HOME", "/nonexistent-sdfg-config", 1);
+  setenv("SDFG_AUTOGRASP_TEST_LAYER_FAULT", "after_create_instance", 1);
+  const Config fromEnvironment = sdfg::layer::loadConfig();
+  unsetenv("SDFG_AUTOGRASP_TEST_LAYER_FAULT");
+  Config c;
+  const bool took = applyConfigValue(c, "test_layer_fault", "after_create_session");
+#if SDFG_LAYER_TEST_FAULTS
+  CHECK(fromFile.testLayerFault == "after_create_space");
+  CHECK(fromEnvironment.testLayerFault == "after_create_instance");
+  CHECK(took);
+  CHECK_THROWS(sdfg::layer::throwIfTestFault(c, "after_create_session"));
+  CHECK_NOTHROW(sdfg::layer::throwIfTestFault(c, "after_create_instance"));
+#else
+  // Unknown: the file's line is ignored with the usual warning, the variable is not read.
+  CHECK(fromFile.testLayerFault == "none");
+  CHECK(fromEnvironment.testLayerFault == "none");
+  CHECK_FALSE(took);
+  CHECK(c.testLayerFault == "none");
+  // Nor does anything throw, whatever the field holds.
+  c.testLayerFault = "after_create_session";
+  CHECK_NOTHROW(sdfg::layer::throwIfTestFault(c, "after_create_session"));
+#endif
 }

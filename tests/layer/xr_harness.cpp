@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 namespace sdfg::test {
 namespace {
@@ -69,9 +70,15 @@ std::string applyEnv(const XrEnv& env) {
   // The layer under test is implicit, found under $XDG_DATA_HOME; nothing else implicit is.
   const fs::path implicit = fs::path(dir) / "data/openxr/1/api_layers/implicit.d";
   fs::create_directories(implicit);
+#ifdef SDFG_LAYER_TEST_JSON
+  const char* const manifest = env.testBuild ? SDFG_LAYER_TEST_JSON : SDFG_LAYER_JSON;
+#else
+  if (env.testBuild) throw std::runtime_error("built without the layer's test build");
+  const char* const manifest = SDFG_LAYER_JSON;
+#endif
   // Removed first: MinGW's libstdc++ 12 refuses to overwrite, whatever the options say.
   fs::remove(implicit / "XrApiLayer_sdfg_autograsp.json");
-  fs::copy_file(SDFG_LAYER_JSON, implicit / "XrApiLayer_sdfg_autograsp.json",
+  fs::copy_file(manifest, implicit / "XrApiLayer_sdfg_autograsp.json",
                 fs::copy_options::overwrite_existing);
   setenv("XDG_DATA_HOME", (fs::path(dir) / "data").c_str(), 1);
   setenv("XDG_DATA_DIRS", "/usr/share", 1);  // core validation's explicit manifest

@@ -23,7 +23,10 @@
 namespace sdfg::test {
 
 struct XrEnv {
-  bool layer = true;               // false: the layer's disable_environment variable is set
+  bool layer = true;  // false: the layer's disable_environment variable is set
+  // The layer's test build in place of the shipped library: the one with test_layer_fault
+  // (layer/test_fault.h), for the cases that make the layer fail on purpose.
+  bool testBuild = false;
   std::string handTracking = "1";  // SDFG_MOCK_HAND_TRACKING: "1", "0" or "absent"
   std::string script;              // mock runtime timeline (empty: none)
   std::vector<std::pair<std::string, std::string>> extra;  // more variables

@@ -100,6 +100,36 @@ bool untilSetUp(const App& app, const Ext& ext, F done,
   return true;
 }
 
+// Milliseconds since `start` (steady clock).
+inline double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+// The bound of a destroy that must stop the worker's work, not wait for it: half the time that
+// work took run whole in this process (`wholeMs`). A number written down would be either too
+// tight for a loaded machine or a sanitizer (a stop takes tens of milliseconds here, 0.35 s at
+// worst with other builds running: docs/threading.md, "Measured") or too loose to tell a stop
+// from a wait. Measured, it grows with the load and the sanitizer as the stop does, while a
+// destroy that waited would still take about the whole.
+inline double destroyBoundMs(double wholeMs) {
+  return wholeMs / 2;
+}
+
+// How long the worker takes to set `mesh` up, run whole (from xrCreateGraspTargetSDFG's return
+// until the target is ready), in a session of its own made with `env`.
+inline double wholeSetUpMs(const XrEnv& env, const TestMesh& mesh) {
+  applyEnv(env);
+  App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}});
+  REQUIRE(app.ok());
+  Ext ext(app);
+  makeTarget(app, ext, mesh, {{0, 0, 0, 1}, {0, 0, -1}});
+  const auto start = std::chrono::steady_clock::now();
+  REQUIRE(untilSetUp(
+      app, ext, [](const auto& s) { return s.readyCount == 1; }, std::chrono::minutes(10)));
+  return msSince(start);
+}
+
 inline float length(const XrVector3f& v) {
   return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
 }

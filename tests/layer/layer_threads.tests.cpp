@@ -9,11 +9,16 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
 #include <future>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "grasp_checks.h"
 #include "mock_runtime_test.h"
@@ -51,10 +56,11 @@ class FrameQueue {
     busy_ = true;
     changed_.notify_all();
   }
-  // Blocks until the frame handed last is ended (finish()).
-  void drain() {
+  // Waits until the frame handed last is ended (finish()), at most `limit`; returns whether it
+  // was.
+  bool drain(std::chrono::milliseconds limit) {
     std::unique_lock lock(mutex_);
-    changed_.wait(lock, [&] { return !busy_; });
+    return changed_.wait_for(lock, limit, [&] { return !busy_; });
   }
   // Nothing once closed.
   std::optional<XrTime> pop() {
@@ -134,6 +140,12 @@ struct Gate {
     REQUIRE(f != nullptr);
     REQUIRE(f(app.instance, command, hold ? XR_TRUE : XR_FALSE, delayMicroseconds) == XR_SUCCESS);
   }
+  // Opens the gate without asserting: for a scope left by a failed assertion, whose exception
+  // another one would turn into std::terminate.
+  void release() const noexcept {
+    if (auto f = app.fn<PFN_xrMockRuntimeGateCallsSDFG>("xrMockRuntimeGateCallsSDFG"))
+      f(app.instance, command, XR_FALSE, 0);
+  }
   uint32_t waiting() const {
     auto f = app.fn<PFN_xrMockRuntimeGateStatsSDFG>("xrMockRuntimeGateStatsSDFG");
     uint32_t waiting = 0;
@@ -142,6 +154,49 @@ struct Gate {
     return waiting;
   }
 };
+
+// What went wrong on either thread, kept for the main thread to assert once the other has
+// ended: Catch2's assertions are for the thread that runs the test only.
+class Failures {
+ public:
+  void add(std::string what) {
+    std::lock_guard lock(mutex_);
+    if (list_.size() < 20) list_.push_back(std::move(what));
+    any_ = true;
+  }
+  bool any() const { return any_; }
+  std::vector<std::string> list() const {
+    std::lock_guard lock(mutex_);
+    return list_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<std::string> list_;
+  std::atomic<bool> any_{false};
+};
+
+// A thread of the test still inside a layer call `limit` after it should have returned: the hang
+// these tests exist to catch, which no join would end. The process exits with the reason, so the
+// run fails now rather than at ctest's timeout.
+[[noreturn]] void exitStuck(std::chrono::seconds limit) {
+  std::fprintf(stderr, "FAIL: a thread is stuck in a layer call (no return in %lld s)\n",
+               static_cast<long long>(limit.count()));
+  std::fflush(stderr);
+  std::_Exit(1);
+}
+
+// Joins `thread` once it has said it ended, waiting at most `limit` (exitStuck()).
+void joinOrExit(std::thread& thread, const std::atomic<bool>& ended, std::chrono::seconds limit) {
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  while (!ended && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(1ms);
+  if (!ended) exitStuck(limit);
+  thread.join();
+}
+
+std::string callFailed(uint64_t frame, const char* call, XrResult result) {
+  return "frame " + std::to_string(frame) + ": " + call + " returned " + std::to_string(result);
+}
 
 }  // namespace
 
@@ -165,33 +220,55 @@ TEST_CASE("Two app threads: a main thread syncing and a render thread locating o
   REQUIRE(untilSetUp(app, ext, [](const auto& s) { return s.readyCount == 1; }));
 
   FrameQueue frames;
-  std::atomic<int> renderFailures{0}, framesRendered{0}, framesGrasping{0}, framesOpen{0};
+  Failures failures;
+  std::atomic<int> framesRendered{0}, framesGrasping{0}, framesOpen{0};
+  std::atomic<bool> renderEnded{false};
   std::thread render([&] {
-    while (const std::optional<XrTime> time = frames.pop()) {
-      const RenderCalls r = renderFrame(app, ext, left, right, *time);
-      if (r.begin != XR_SUCCESS || r.end != XR_SUCCESS || r.left != XR_SUCCESS ||
-          r.right != XR_SUCCESS || r.state != XR_SUCCESS || !r.jointsValid)
-        ++renderFailures;
-      ++(r.grasping ? framesGrasping : framesOpen);
-      ++framesRendered;
+    // Nothing may leave the thread (an exception would end the process); a failure stops both.
+    try {
+      while (const std::optional<XrTime> time = frames.pop()) {
+        const RenderCalls r = renderFrame(app, ext, left, right, *time);
+        const uint64_t frame = uint64_t(framesRendered.load());
+        const std::pair<const char*, XrResult> calls[] = {
+            {"xrBeginFrame", r.begin},
+            {"xrLocateHandJointsEXT (left)", r.left},
+            {"xrLocateHandJointsEXT (right)", r.right},
+            {"xrGetGraspStateSDFG", r.state},
+            {"xrEndFrame", r.end}};
+        for (const auto& [call, result] : calls)
+          if (result != XR_SUCCESS) failures.add(callFailed(frame, call, result));
+        if (r.right == XR_SUCCESS && !r.jointsValid)
+          failures.add("frame " + std::to_string(frame) + ": the right hand is not active");
+        ++(r.grasping ? framesGrasping : framesOpen);
+        ++framesRendered;
+        frames.finish();
+      }
+    } catch (const std::exception& e) {
+      failures.add(std::string("the render thread threw: ") + e.what());
       frames.finish();
     }
+    renderEnded = true;
   });
-  int mainFailures = 0;
   // Paced at 90 Hz, as an app's frames are: two threads in unpaced loops take both cores of a
   // 2-core machine, and the layer's worker (which an app leaves time for) then finished one grab
   // in a thousand frames.
   auto next = std::chrono::steady_clock::now();
-  for (uint64_t i = 0; i < kFrames; ++i) {
+  for (uint64_t i = 0; i < kFrames && !failures.any(); ++i) {
     next += std::chrono::microseconds(11111);
     std::this_thread::sleep_until(next);
     XrEventDataBuffer e{XR_TYPE_EVENT_DATA_BUFFER};
     while (xrPollEvent(app.instance, &e) == XR_SUCCESS)
       e = XrEventDataBuffer{XR_TYPE_EVENT_DATA_BUFFER};
-    frames.drain();
+    if (!frames.drain(60s)) {
+      failures.add("frame " + std::to_string(i) + ": the render thread did not end its frame");
+      break;
+    }
     XrFrameState fs{XR_TYPE_FRAME_STATE};
     XrFrameWaitInfo wi{XR_TYPE_FRAME_WAIT_INFO};
-    if (xrWaitFrame(app.session, &wi, &fs) != XR_SUCCESS) ++mainFailures;
+    if (const XrResult r = xrWaitFrame(app.session, &wi, &fs); r != XR_SUCCESS) {
+      failures.add(callFailed(i, "xrWaitFrame", r));
+      break;  // no frame to hand over
+    }
     frames.push(fs.predictedDisplayTime);
     // The main thread also moves the target a little, as a physics step would.
     const float shift = 0.0005f * float(i % 20);
@@ -199,14 +276,17 @@ TEST_CASE("Two app threads: a main thread syncing and a render thread locating o
                                          nullptr,
                                          app.local,
                                          {{0, 0, 0, 1}, {centre.x + shift, centre.y, centre.z}}};
-    if (ext.place(target, &placement) != XR_SUCCESS) ++mainFailures;
-    if (syncApp(app) != XR_SUCCESS) ++mainFailures;
+    if (const XrResult r = ext.place(target, &placement); r != XR_SUCCESS)
+      failures.add(callFailed(i, "xrSetGraspTargetPlacementSDFG", r));
+    if (const XrResult r = syncApp(app); r != XR_SUCCESS)
+      failures.add(callFailed(i, "xrSyncActions", r));
   }
-  frames.drain();
+  if (!frames.drain(60s)) failures.add("the render thread did not end the last frame");
   frames.close();
-  render.join();
-  CHECK(mainFailures == 0);
-  CHECK(renderFailures == 0);
+  joinOrExit(render, renderEnded, 60s);
+  const std::vector<std::string> failed = failures.list();
+  CAPTURE(failed);
+  CHECK(failed.empty());
   CHECK(framesRendered == int(kFrames));
   // The squeeze went on and off: the render thread saw the hand grasp and let go.
   CAPTURE(framesGrasping.load(), framesOpen.load());
@@ -239,8 +319,18 @@ TEST_CASE(
   XrFrameState fs{XR_TYPE_FRAME_STATE};
   XrFrameWaitInfo wi{XR_TYPE_FRAME_WAIT_INFO};
   REQUIRE(xrWaitFrame(app.session, &wi, &fs) == XR_SUCCESS);
+  // The calls on the other threads, and the gate's opening on any way out of this scope: a
+  // failed REQUIRE below unwinds through the futures, whose destructors wait for their calls,
+  // and the main thread's sync returns only once the gate is open. (Declared in this order,
+  // the gate opens before either future is waited for.)
+  std::future<XrResult> mainSync;
+  std::future<RenderCalls> renderFrameCalls;
+  struct OpenOnExit {
+    const Gate& gate;
+    ~OpenOnExit() { gate.release(); }
+  } openOnExit{gate};
   gate.set(true);
-  auto mainSync = std::async(std::launch::async, [&] { return syncApp(app); });
+  mainSync = std::async(std::launch::async, [&] { return syncApp(app); });
   const auto deadline = std::chrono::steady_clock::now() + 60s;
   while (gate.waiting() == 0 && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(1ms);
@@ -249,7 +339,7 @@ TEST_CASE(
   // The render thread's frame, with the main thread held: every call returns. (Before the layer
   // stopped holding its session lock across runtime calls, the locates waited for the sync: this
   // wait then ran out.)
-  auto renderFrameCalls = std::async(std::launch::async, [&] {
+  renderFrameCalls = std::async(std::launch::async, [&] {
     return renderFrame(app, ext, left, right, fs.predictedDisplayTime);
   });
   const bool done = renderFrameCalls.wait_for(60s) == std::future_status::ready;
@@ -257,6 +347,8 @@ TEST_CASE(
   CHECK(gate.waiting() == 1);
   CHECK(mainSync.wait_for(0s) == std::future_status::timeout);
   gate.set(false);
+  // Open, nothing holds the render thread's calls: one still running is a hang of the layer.
+  if (!done && renderFrameCalls.wait_for(60s) != std::future_status::ready) exitStuck(60s);
   REQUIRE(done);
   const RenderCalls r = renderFrameCalls.get();
   CHECK(r.begin == XR_SUCCESS);

@@ -86,9 +86,10 @@ TEST_CASE("A held target that moves keeps the grasp shown in every frame, on its
 TEST_CASE("Destroying a target or the session while the worker sets it up is safe and prompt",
           "[layer][worker]") {
   const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
-  applyEnv(squeezingRight(grip));
   // About 330k triangles: a set-up of a good fraction of a second, still running below.
   const TestMesh big = makeIcosphere(0.04f, 7);
+  const double wholeMs = wholeSetUpMs(squeezingRight(grip), big);
+  applyEnv(squeezingRight(grip));
   const XrVector3f centre = boxCentreInLocal(grip, true);
   App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}});
   REQUIRE(app.ok());
@@ -102,10 +103,11 @@ TEST_CASE("Destroying a target or the session while the worker sets it up is saf
   REQUIRE(setupInfo(app, ext).pendingCount == 1);  // the second set-up has not finished
   const auto start = std::chrono::steady_clock::now();
   app.destroySession();
-  // The worker is joined inside xrDestroySession, its set-up stopped: the call returns within the
-  // bound docs/threading.md states (tens of milliseconds; a second allowed for a loaded machine
-  // under the sanitizers), not after the set-up.
-  CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(1));
+  // The worker is joined inside xrDestroySession, its set-up stopped: the call returns in tens of
+  // milliseconds (docs/threading.md), not after the set-up, which took `wholeMs` run whole.
+  const double destroyMs = msSince(start);
+  CAPTURE(wholeMs);
+  CHECK(destroyMs < destroyBoundMs(wholeMs));
   CHECK(validationLog().empty());
 }
 

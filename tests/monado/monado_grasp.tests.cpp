@@ -150,9 +150,47 @@ int contactsOf(const XrGraspStateSDFG& s) {
   return n;
 }
 
+// An app that loads its level first: its action set made, suggested and attached now, after
+// frames ran. Returns the attach's result; app.appSet is synced by every frame after it.
+XrResult attachLate(App& app) {
+  XrActionSetCreateInfo asci{XR_TYPE_ACTION_SET_CREATE_INFO};
+  std::strcpy(asci.actionSetName, "late_app");
+  std::strcpy(asci.localizedActionSetName, "Late app");
+  XrActionSet set = XR_NULL_HANDLE;
+  REQUIRE(xrCreateActionSet(app.instance, &asci, &set) == XR_SUCCESS);
+  XrActionCreateInfo aci{XR_TYPE_ACTION_CREATE_INFO};
+  aci.actionType = XR_ACTION_TYPE_FLOAT_INPUT;
+  std::strcpy(aci.actionName, "grab");
+  std::strcpy(aci.localizedActionName, "Grab");
+  aci.countSubactionPaths = 2;
+  aci.subactionPaths = app.hands.data();
+  XrAction squeeze = XR_NULL_HANDLE;
+  REQUIRE(xrCreateAction(set, &aci, &squeeze) == XR_SUCCESS);
+  XrPath profile = XR_NULL_PATH, right = XR_NULL_PATH;
+  xrStringToPath(app.instance, "/interaction_profiles/khr/simple_controller", &profile);
+  xrStringToPath(app.instance, "/user/hand/right/input/select/click", &right);
+  XrActionSuggestedBinding b{squeeze, right};
+  XrInteractionProfileSuggestedBinding sb{XR_TYPE_INTERACTION_PROFILE_SUGGESTED_BINDING};
+  sb.interactionProfile = profile;
+  sb.countSuggestedBindings = 1;
+  sb.suggestedBindings = &b;
+  REQUIRE(xrSuggestInteractionProfileBindings(app.instance, &sb) == XR_SUCCESS);
+  XrSessionActionSetsAttachInfo at{XR_TYPE_SESSION_ACTION_SETS_ATTACH_INFO};
+  at.countActionSets = 1;
+  at.actionSets = &set;
+  const XrResult r = xrAttachSessionActionSets(app.session, &at);
+  if (r == XR_SUCCESS) {
+    app.appSet = set;
+    app.appSqueeze = squeeze;
+  }
+  return r;
+}
+
 // One test case per session kind, each skipped (before any assertion) when it cannot run: a
 // case that skipped one generated session after the other ran would report its failures as a skip.
-void grabAndRelease(Graphics graphics) {
+// `appActions` false: an app with no action sets until the end (the grab update runs in
+// xrWaitFrame and the hand grabs by closing), which then attaches one late.
+void grabAndRelease(Graphics graphics, bool appActions = true) {
   const std::string manifest = monadoManifest();
   if (manifest.empty()) SDFG_SKIP("no Monado build (../shared/monado absent)");
   if (graphics != Graphics::headless && !vulkanUnavailable().empty())
@@ -167,6 +205,7 @@ void grabAndRelease(Graphics graphics) {
   options.extensions = {XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME,
                         XR_KHR_CONVERT_TIMESPEC_TIME_EXTENSION_NAME};
   options.graphics = graphics;
+  options.appActions = appActions;
   App app(options);
   REQUIRE(app.ok());
   RemoteClient remote;
@@ -245,6 +284,14 @@ void grabAndRelease(Graphics graphics) {
       app, frame,
       [&] { return ext.state(app.session, &gi, &state) == XR_SUCCESS && !state.isGrasping; },
       30.0));
+  if (!appActions) {
+    // Its attach after all those frames is answered as without the layer, and so are its syncs.
+    CHECK(attachLate(app) == XR_SUCCESS);
+    int frames = 0;
+    CHECK(framesUntil(
+        app, frame, [&] { return ++frames >= 10; }, 30.0));
+    CHECK(app.lastSync == XR_SUCCESS);
+  }
   CHECK(validationLog().empty());
 }
 
@@ -258,4 +305,11 @@ TEST_CASE("On Monado a squeezed tracked hand grasps a sphere and lets go (Vulkan
 TEST_CASE("On Monado a squeezed tracked hand grasps a sphere and lets go (headless session)",
           "[monado][grasp]") {
   grabAndRelease(Graphics::headless);
+}
+
+TEST_CASE(
+    "On Monado an app with no action sets grasps by closing its tracked hand, then attaches "
+    "late",
+    "[monado][grasp]") {
+  grabAndRelease(Graphics::headless, /*appActions=*/false);
 }

@@ -1,10 +1,41 @@
 #!/usr/bin/env bash
-# Installs what is missing, then configures and builds the project with the given preset
-# (default: "default"). Used by run-tests.sh and run-demo.sh.
+# Installs what is missing, then configures and builds the project with a CMake preset. Used by
+# run-tests.sh (everything) and run-demo.sh (the demo alone).
+#   build.sh [PRESET] [--deps demo] [--target NAME]...
+# PRESET: default "default". --deps demo: install only the demo's packages
+# (install-deps.sh --demo; default: every package). --target: build only these targets and what
+# they depend on (default: all). SDFG_BUILD_DIR: the build folder (default: the preset's own,
+# build/<preset>).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-preset="${1:-default}"
-"$root/scripts/install-deps.sh"
-cmake -S "$root" --preset "$preset" >/dev/null
+preset=default
+if [ $# -gt 0 ] && [ "${1#-}" = "$1" ]; then
+  preset="$1"
+  shift
+fi
+deps=()
+targets=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --deps)
+      [ "${2:-}" = demo ] || { echo "build.sh: --deps takes 'demo'" >&2; exit 2; }
+      deps=(--demo)
+      shift 2
+      ;;
+    --target)
+      [ -n "${2:-}" ] || { echo "build.sh: --target needs a name" >&2; exit 2; }
+      targets+=(--target "$2")
+      shift 2
+      ;;
+    *)
+      echo "usage: build.sh [PRESET] [--deps demo] [--target NAME]..." >&2
+      exit 2
+      ;;
+  esac
+done
+build_dir="${SDFG_BUILD_DIR:-$root/build/$preset}"
+
+"$root/scripts/install-deps.sh" "${deps[@]}"
+cmake -S "$root" --preset "$preset" -B "$build_dir" >/dev/null
 jobs="$(nproc 2>/dev/null || echo 2)"
-cmake --build "$root/build/$preset" --parallel "$jobs"
+cmake --build "$build_dir" --parallel "$jobs" "${targets[@]}"

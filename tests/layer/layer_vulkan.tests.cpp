@@ -261,9 +261,11 @@ TEST_CASE("Destroying a buffer target the GPU still reads fails, keeps the targe
   const TestMesh sphere = makeIcosphere(0.04f, 3);
   // The layer's test-only key test_gpu_fault (docs/layer.md): the first removal of a buffer
   // target finds the GPU still reading its buffers, as after the layer's 2 s wait on a hung
-  // device (without the wait).
-  XrEnv env = squeezeEnv(grip);
+  // device (without the wait). The grab waits for the GPU path, and its build time bound is out
+  // of a loaded machine's reach: the hand must come to hold the target.
+  XrEnv env = squeezeEnv(grip, "on", /*squeeze=*/false);
   env.extra.push_back({"SDFG_AUTOGRASP_TEST_GPU_FAULT", "stuck_reads_once"});
+  env.extra.push_back({"SDFG_AUTOGRASP_BUILD_TIME_LIMIT_MS", "600000"});
   applyEnv(env);
   const size_t messagesBefore = vulkanMessages().size();
   {
@@ -281,6 +283,7 @@ TEST_CASE("Destroying a buffer target the GPU still reads fails, keeps the targe
         XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, app.local, {{0, 0, 0, 1}, centre}};
     XrGraspTargetSDFG t = XR_NULL_HANDLE;
     REQUIRE(ext.create(app.session, &ci, &t) == XR_SUCCESS);
+    squeezeWhenGpuReady(app, ext, grip);
     State s = runUntilGrasping(app, ext);
     REQUIRE(s.state.isGrasping);
     REQUIRE(s.state.target == t);

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Installs what is missing, then configures and builds the project with a CMake preset. Used by
 # run-tests.sh (everything) and run-demo.sh (the demo alone).
-#   build.sh [PRESET] [--deps demo] [--target NAME]...
+#   build.sh [PRESET] [--deps demo] [--target NAME]... [--build-dir DIR]
 # PRESET: default "default". --deps demo: install only the demo's packages
 # (install-deps.sh --demo; default: every package). --target: build only these targets and what
-# they depend on (default: all). SDFG_BUILD_DIR: the build folder (default: the preset's own,
-# build/<preset>).
+# they depend on (default: all). --build-dir: the build folder (default: the preset's own,
+# build/<preset>, where ctest --preset looks).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 preset=default
@@ -15,6 +15,7 @@ if [ $# -gt 0 ] && [ "${1#-}" = "$1" ]; then
 fi
 deps=()
 targets=()
+build_dir="$root/build/$preset"
 while [ $# -gt 0 ]; do
   case "$1" in
     --deps)
@@ -27,13 +28,17 @@ while [ $# -gt 0 ]; do
       targets+=(--target "$2")
       shift 2
       ;;
+    --build-dir)
+      [ -n "${2:-}" ] || { echo "build.sh: --build-dir needs a folder" >&2; exit 2; }
+      build_dir="$2"
+      shift 2
+      ;;
     *)
-      echo "usage: build.sh [PRESET] [--deps demo] [--target NAME]..." >&2
+      echo "usage: build.sh [PRESET] [--deps demo] [--target NAME]... [--build-dir DIR]" >&2
       exit 2
       ;;
   esac
 done
-build_dir="${SDFG_BUILD_DIR:-$root/build/$preset}"
 
 "$root/scripts/install-deps.sh" "${deps[@]}"
 cmake -S "$root" --preset "$preset" -B "$build_dir" >/dev/null

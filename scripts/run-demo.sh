@@ -13,9 +13,9 @@
 # pictures and figures (GCC 12's -O1 has false maybe-uninitialized warnings in libstdc++'s
 # std::optional moves, hence that warning off there). run-tests.sh installs and builds everything.
 # Extra arguments go to autograsp-demo (see --help), e.g. --mesh my.obj or --width 1024.
-# SDFG_BUILD_DIR: another build folder.
+# SDFG_BUILD_DIR: another build folder (default build/demo).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${SDFG_BUILD_DIR:-$root/build/demo}"
-SDFG_BUILD_DIR="$build_dir" "$root/scripts/build.sh" demo --deps demo --target autograsp-demo
+"$root/scripts/build.sh" demo --deps demo --target autograsp-demo --build-dir "$build_dir"
 "$build_dir/tools/demo/autograsp-demo" --embedded-only --out "$root/out/demo" "$@"

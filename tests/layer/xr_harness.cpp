@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -119,6 +120,14 @@ std::string applyEnv(const XrEnv& env) {
     setenv(k.c_str(), v.c_str(), 1);
     previousExtra.push_back(k);
   }
+  // A grab whose build runs past build_time_limit_ms (1 s by default) is given up and the hand
+  // stays open until the squeeze is released: a test waiting for a grasp would wait out its whole
+  // bound wherever a loaded machine or a sanitizer made one build slow. The tests wait for
+  // outcomes, so the layer's bound is lifted unless a test sets it.
+  constexpr const char* kBuildLimit = "SDFG_AUTOGRASP_BUILD_TIME_LIMIT_MS";
+  if (std::none_of(env.extra.begin(), env.extra.end(),
+                   [&](const auto& kv) { return kv.first == kBuildLimit; }))
+    setenv(kBuildLimit, "600000", 1);
   return cv;
 }
 

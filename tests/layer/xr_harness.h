@@ -29,7 +29,8 @@ struct XrEnv {
   bool testBuild = false;
   std::string handTracking = "1";  // SDFG_MOCK_HAND_TRACKING: "1", "0" or "absent"
   std::string script;              // mock runtime timeline (empty: none)
-  std::vector<std::pair<std::string, std::string>> extra;  // more variables
+  // More variables. SDFG_AUTOGRASP_BUILD_TIME_LIMIT_MS is 600000 unless given here (applyEnv()).
+  std::vector<std::pair<std::string, std::string>> extra;
 };
 
 // Sets the process environment for the next instance; returns the core-validation log path.

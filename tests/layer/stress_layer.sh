@@ -23,12 +23,13 @@ spin() {
     while [ "$i" -lt 200000 ]; do i=$((i + 1)); done
   done
 }
-stop_busy() {
-  for pid in "${busy[@]}"; do kill "$pid" 2>/dev/null; done
-  for pid in "${busy[@]}"; do wait "$pid" 2>/dev/null; done
+child=""
+stop_all() {
+  for pid in "${busy[@]}" $child; do kill "$pid" 2>/dev/null; done
+  for pid in "${busy[@]}" $child; do wait "$pid" 2>/dev/null; done
   busy=()
 }
-trap stop_busy EXIT
+trap stop_all EXIT
 trap 'exit 130' INT TERM
 spin &
 busy+=($!)
@@ -40,8 +41,13 @@ failed=0
 start=$(date +%s)
 for run in $(seq 1 "$runs"); do
   run_start=$(date +%s)
-  "$tests" "$@" >"$log" 2>&1
+  # In the background: bash runs a trap only once a foreground command ends, and a stopped run
+  # must not go on with the loops gone.
+  "$tests" "$@" >"$log" 2>&1 &
+  child=$!
+  wait "$child"
   status=$?
+  child=""
   took=$(($(date +%s) - run_start))
   if [ "$status" -eq 0 ]; then
     echo "run $run/$runs: passed in $took s"

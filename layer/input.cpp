@@ -227,8 +227,12 @@ void updateInputAtFrame(SessionState& s) {
   } else if (!attached) {
     // The layer's set is not attached (the app has attached none yet, or the runtime refused the
     // layer's): the update runs once a frame on what the runtime gives without actions, the
-    // hands it tracks, so the outer hand and grabs by closing the hand work.
-    syncGrasps(s, "xrWaitFrame");
+    // hands it tracks, so the outer hand and grabs by closing the hand work. Without them there
+    // is no input at all, and the frame is left alone (a frame-timing app pays nothing).
+    const InstanceState& inst = *s.instance;
+    if (inst.downstreamHandTracking && inst.next.xrLocateHandJointsEXT != nullptr &&
+        !inst.runtimeSystemLacksHands)
+      syncGrasps(s, "xrWaitFrame");
   }
   // Attached with the app's set: the app's xrSyncActions runs the update.
 }

@@ -94,6 +94,7 @@ std::vector<Setting> settingsOf(const Config& c) {
           boolean("exact_check", c.exactCheck),
           number("build_time_limit_ms", c.buildTimeLimitMs),
           boolean("synthesis", c.synthesis),
+          boolean("attach_alone", c.attachAlone),
           text("gpu", gpuName(c.gpu)),
           boolean("extra_queue", c.extraQueue),
           boolean("clear_hand", c.clearHand),

@@ -13,9 +13,8 @@
 #include <vector>
 
 #include "grasp_v2.h"
+#include "mock_checks.h"
 #include "scene/analytic_shape.h"
-// After the OpenXR headers (xr_harness.h), which it assumes.
-#include "../mock_runtime/mock_runtime_test.h"
 
 namespace {
 
@@ -23,19 +22,6 @@ using namespace sdfg;
 using namespace sdfg::test;
 
 const XrPosef kGrip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
-
-XrMockRuntimeStatsSDFG mockStats(const App& app) {
-  XrMockRuntimeStatsSDFG s{};
-  auto get = app.fn<PFN_xrMockRuntimeGetStatsSDFG>("xrMockRuntimeGetStatsSDFG");
-  REQUIRE(get != nullptr);
-  REQUIRE(get(app.session, &s) == XR_SUCCESS);
-  return s;
-}
-
-bool isActive(const App& app, XrHandTrackerEXT tracker) {
-  Joints j;
-  return locateJoints(app, tracker, j) == XR_SUCCESS && j.locations.isActive;
-}
 
 // What an app that loads its level first does: makes its action set with a squeeze action,
 // suggests Touch bindings and attaches it, all now (frames may have run). The results of the

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "grasp_checks.h"
-#include "mock_runtime_test.h"
+#include "mock_checks.h"
 #include "test_scenes.h"
 #include "xr_harness.h"
 
@@ -49,14 +49,6 @@ XrGraspStateSDFG graspState(const App& app, const Ext& ext) {
   XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG};
   REQUIRE(ext.state(app.session, &gi, &st) == XR_SUCCESS);
   return st;
-}
-
-XrMockRuntimeStatsSDFG mockStats(const App& app) {
-  auto get = app.fn<PFN_xrMockRuntimeGetStatsSDFG>("xrMockRuntimeGetStatsSDFG");
-  REQUIRE(get != nullptr);
-  XrMockRuntimeStatsSDFG stats{};
-  REQUIRE(get(app.session, &stats) == XR_SUCCESS);
-  return stats;
 }
 
 // One 327,680-triangle sphere.

@@ -9,10 +9,9 @@
 #include <utility>
 
 #include "grasp_checks.h"
+#include "mock_checks.h"
 #include "test_scenes.h"
 #include "xr_harness.h"
-// After the OpenXR headers (xr_harness.h), which it assumes.
-#include "../mock_runtime/mock_runtime_test.h"
 
 namespace {
 
@@ -26,19 +25,6 @@ bool framesUntil(App& app, const std::function<bool()>& done, double seconds = 3
     if (done()) return true;
   }
   return false;
-}
-
-XrMockRuntimeStatsSDFG mockStats(const App& app) {
-  XrMockRuntimeStatsSDFG s{};
-  auto get = app.fn<PFN_xrMockRuntimeGetStatsSDFG>("xrMockRuntimeGetStatsSDFG");
-  REQUIRE(get != nullptr);
-  REQUIRE(get(app.session, &s) == XR_SUCCESS);
-  return s;
-}
-
-bool isActive(const App& app, XrHandTrackerEXT tracker) {
-  Joints j;
-  return locateJoints(app, tracker, j) == XR_SUCCESS && j.locations.isActive;
 }
 
 TestMesh clockwise(TestMesh m) {

@@ -227,6 +227,7 @@ struct UpdateReport {
   std::vector<std::pair<uint64_t, MeshSetupReport>> setups;
   std::vector<std::pair<uint64_t, std::string>> refusedUpdates;
   std::vector<std::pair<uint64_t, std::string>> setupFailures;
+  std::vector<std::pair<uint64_t, std::string>> readbackNotes;
 };
 
 // The engine's update of both hands. The caller holds the lock; nothing here calls out.
@@ -266,6 +267,7 @@ void updateHands(SessionState& s, const Gathered& g, UpdateReport& report) {
   report.setups = s.grasp->takeSetupReports();
   report.refusedUpdates = s.grasp->takeRefusedUpdates();
   report.setupFailures = s.grasp->takeSetupFailures();
+  report.readbackNotes = s.grasp->takeReadbackNotes();
 }
 
 void logReport(const InstanceState& inst, const UpdateReport& report, const char* cmd) {
@@ -304,6 +306,8 @@ void logReport(const InstanceState& inst, const UpdateReport& report, const char
   for (const auto& [id, why] : report.setupFailures)
     SDFG_LOG_WARN(cmd, "grasp target 0x%llx cannot be grasped: its set-up failed (%s)",
                   static_cast<unsigned long long>(id), why.c_str());
+  for (const auto& [id, why] : report.readbackNotes)
+    SDFG_LOG_WARN(cmd, "grasp target 0x%llx: %s", static_cast<unsigned long long>(id), why.c_str());
 }
 
 }  // namespace

@@ -113,7 +113,15 @@ typedef struct XrGraspTargetVerticesSDFG {
 
 #ifdef XR_USE_GRAPHICS_API_VULKAN
 // Mesh as Vulkan buffers of the session's VkDevice (a skinned mesh the app already writes on the
-// GPU), read by the layer's compute work at every build; nothing is copied to the CPU. Only on a
+// GPU), read by the layer's compute work. The layer reads the mesh back into memory of its own
+// (a compute pass on the binding's queue inside xrEndFrame; never a CPU wait in the app's frame)
+// and from then on treats it as it treats a mesh given as arrays: exact stops and contacts, a
+// member of scenes, seen by the outer hand. After each update naming these buffers it reads the
+// positions again (while the target is within half a metre of a hand; farther, once it comes
+// near), so what the hands see of a deforming mesh is one readback behind the app's last write:
+// a frame or two. The indices are read at creation and when an update names other index
+// buffers. Until the first readback is in, the target is grasped on the field the GPU builds
+// from the buffers. Only on a
 // session created with XrGraphicsBindingVulkanKHR (or ...Vulkan2KHR) whose SDFs are built on the
 // GPU; otherwise XR_ERROR_GRAPHICS_DEVICE_INVALID (no Vulkan binding) or
 // XR_ERROR_FEATURE_UNSUPPORTED (the session builds on the CPU: gpu = false, no usable device, or
@@ -129,7 +137,11 @@ typedef struct XrGraspTargetVerticesSDFG {
 //   inside xrBeginFrame / xrEndFrame. Submit the commands that write them (skinning) on that
 //   queue before the xrEndFrame of the frame whose xrSyncActions should see them, and do not
 //   write them from another queue without waiting for the frame's work.
-// - Index values out of range, and triangles with a non-finite corner, are skipped by the GPU.
+// - Index values out of range, and triangles with a non-finite corner, are skipped by the GPU;
+//   the read-back mesh leaves out the first kind, and a non-finite corner refuses it (the target
+//   is then grasped on its field only; the layer logs either once). Shaders read 32-bit words:
+//   a 16-bit index in the last two bytes of a buffer whose size is not a multiple of 4 cannot be
+//   read, and its triangle is left out.
 // - bounds: an axis-aligned box in the target frame that holds the mesh at all times (for a
 //   skinned mesh, over its whole animation): it decides whether the target is in a grab box.
 typedef struct XrGraspTargetVulkanBuffersSDFG {
@@ -330,10 +342,11 @@ typedef enum XrGraspContactPartSDFG {
 // length from sphereCenter to surfacePoint). For targets with a CPU mesh (isExact true) they come
 // from one exact query of the mesh: distance equals the mesh's exact signed distance at
 // sphereCenter within 0.1 mm (its sign is the side of the mesh's nearest sheet, which on a mesh
-// with holes can differ from an inside/outside test right next to a hole). For Vulkan buffer
-// targets (isExact false) they come from the grab-box signed distance field the layer built
-// (trilinear value and gradient), off by up to the field's error: about a millimetre at the default
-// 16^3 resolution, several near sharp edges and thin parts.
+// with holes can differ from an inside/outside test right next to a hole). Vulkan buffer targets
+// are exact too once the layer has read their mesh back; before that, or where it refused the
+// read-back mesh (isExact false), they come from the grab-box signed distance field the layer
+// built (trilinear value and gradient), off by up to the field's error: about a millimetre at the
+// default 16^3 resolution, several near sharp edges and thin parts.
 typedef struct XrGraspFingerContactSDFG {
   XrGraspContactPartSDFG part;
   XrHandJointEXT joint;      // JOINT_SPHERE: the joint; BONE_CAPSULE: the bone's first joint

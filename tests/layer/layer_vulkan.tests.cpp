@@ -223,27 +223,30 @@ TEST_CASE("A target in the app's Vulkan buffers (strided, 16-bit indices) is gra
       State s = runUntilGrasping(app, ext);
       REQUIRE(s.state.isGrasping);
       CHECK(s.state.target == t);
-      CHECK(s.build.graspBackend == XR_GRASP_SDF_BACKEND_VULKAN_SDFG);
+      // Built on the GPU from the buffers, or (once the layer has read the mesh back) like a CPU
+      // mesh: on the CPU while the GPU path warms up, else on the GPU.
+      CHECK(s.build.graspBackend != XR_GRASP_SDF_BACKEND_NONE_SDFG);
       checkContacts(outcome(app, tracker, s),
                     [&](const XrVector3f& p) { return length(sub(p, centre)) - radius; });
-      float curlBefore = 0.0f;
-      for (const auto& f : s.state.fingers) curlBefore += f.curl;
+      auto curls = [&] {
+        float sum = 0.0f;
+        for (const auto& f : s.state.fingers) sum += f.curl;
+        return sum;
+      };
+      const float curlBefore = curls();
 
       // A skinned mesh's new pose: the sphere shrinks in place; nothing of the GPU reads it now
-      // (the hand holds still, so no build is running).
+      // (the hand holds still, so no build or readback is running).
       REQUIRE(s.build.pendingGpuBuilds == 0);
-      const uint64_t builds = s.build.gpuBuildCount;
       writeVertices(m, sphere, 0.85f);
       REQUIRE(update(t, &m.desc) == XR_SUCCESS);
+      // The fingers follow the smaller surface once the change is built (or read back).
       app.framesUntil([&] {
         s = graspState(app, ext);
-        return s.build.gpuBuildCount > builds;
+        return curls() > curlBefore + 0.05f;
       });
-      REQUIRE(s.build.gpuBuildCount > builds);
       REQUIRE(s.state.isGrasping);
-      float curlAfter = 0.0f;
-      for (const auto& f : s.state.fingers) curlAfter += f.curl;
-      CHECK(curlAfter > curlBefore + 0.05f);  // the fingers followed the smaller surface
+      CHECK(curls() > curlBefore + 0.05f);
       checkContacts(outcome(app, tracker, s),
                     [&](const XrVector3f& p) { return length(sub(p, centre)) - radius * 0.85f; });
       REQUIRE(ext.destroy(t) == XR_SUCCESS);
@@ -499,9 +502,11 @@ TEST_CASE("Destroying a session while its pipelines are being made neither hangs
 }
 
 // XR_SDFG_auto_grasp version 2 on a target that exists only in the app's Vulkan buffers: the
-// layer has no CPU mesh, so each finger's contact comes from the grab-box field, says so, and
-// is still consistent with itself and near the analytic sphere (the field's error, not 0.1 mm).
-TEST_CASE("Contacts on a Vulkan buffer target come from the field and say so", "[layer][vulkan]") {
+// layer reads the mesh back and sets it up as it does a CPU mesh, so each finger's contact is
+// exact (the hand that grasped on the field alone solves again once the copy is in) and lies on
+// the icosphere's triangles.
+TEST_CASE("Contacts on a Vulkan buffer target are exact once its mesh is read back",
+          "[layer][vulkan]") {
   if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
   const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
   const XrVector3f centre = boxCentreInLocal(grip, /*right=*/true);
@@ -524,7 +529,14 @@ TEST_CASE("Contacts on a Vulkan buffer target come from the field and say so", "
     XrGraspContactsSDFG contacts{XR_TYPE_GRASP_CONTACTS_SDFG};
     XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG, &contacts};
     XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
-    REQUIRE(ext.state(app.session, &gi, &st) == XR_SUCCESS);
+    // Every touching finger exact: the read-back mesh is set up and the hand solved on it.
+    app.framesUntil([&] {
+      REQUIRE(ext.state(app.session, &gi, &st) == XR_SUCCESS);
+      bool exact = st.isGrasping == XR_TRUE;
+      for (int f = 0; f < 5; ++f)
+        if (st.fingers[f].inContact && !contacts.fingers[f].isExact) exact = false;
+      return exact;
+    });
     int touching = 0;
     for (int f = 0; f < 5; ++f) {
       const XrGraspFingerContactSDFG& c = contacts.fingers[f];
@@ -532,12 +544,16 @@ TEST_CASE("Contacts on a Vulkan buffer target come from the field and say so", "
       if (!st.fingers[f].inContact) continue;
       ++touching;
       REQUIRE(c.part != XR_GRASP_CONTACT_PART_NONE_SDFG);
-      CHECK(c.isExact == XR_FALSE);
+      CHECK(c.isExact == XR_TRUE);
       CHECK(std::memcmp(&c.sphereCenter, &st.fingers[f].contactPoint, sizeof(XrVector3f)) == 0);
       const float r = length(c.sphereCenter);  // the sphere's centre is the target's origin
       CHECK(std::abs(length(sub(c.sphereCenter, c.surfacePoint)) - std::abs(c.distance)) < 1e-5f);
-      // The 16^3 field's error on a sphere: well under 2 mm.
-      CHECK(std::abs(c.distance - (r - radius)) < 0.002f);
+      // On the icosphere's triangles: between the sphere and its flattest face's plane.
+      const float s = length(c.surfacePoint);
+      CHECK(s <= radius * 1.0001f);
+      CHECK(s >= radius * 0.99f);
+      // The stop is the exact check's (0.1 mm), not the field's millimetres.
+      CHECK(std::abs(c.distance) < c.sphereRadius + 0.0005f);
       const XrVector3f& n = c.surfaceNormal;
       CHECK((n.x * c.sphereCenter.x + n.y * c.sphereCenter.y + n.z * c.sphereCenter.z) / r > 0.95f);
     }

@@ -173,9 +173,12 @@ Status GraspSession::addDeviceTarget(uint64_t id, const Aabb& bounds) {
   if (!deferredUsable() || !deferred_->hasDeviceMesh(id)) return Status::unsupported;
   Target t;
   t.bounds = bounds;
+  t.deviceTarget = true;
   auto [it, inserted] = targets_.emplace(id, std::move(t));
   (void)inserted;
   reindex(id, it->second);
+  // Read back at once, as a CPU mesh is set up at once: most of a scene is still.
+  askReadback(id, it->second);
   return Status::ok;
 }
 
@@ -262,7 +265,17 @@ Status GraspSession::updateTargetBounds(uint64_t id, const Aabb& bounds) {
 Status GraspSession::touchTarget(uint64_t id) {
   auto it = targets_.find(id);
   if (it == targets_.end()) return Status::invalid_argument;
-  ++it->second.version;
+  Target& t = it->second;
+  // A target built from the device's buffers sees the change at its next build; one built from
+  // its readback, once the readback of the change is in (collectReadbacks).
+  if (t.mirror != Mirror::ready) ++t.version;
+  if (t.mirror == Mirror::none || t.mirror == Mirror::failed) return Status::ok;
+  if (nearHand(id, t)) {
+    askReadback(id, t);
+  } else if (!t.readbackStale) {
+    t.readbackStale = true;
+    staleTargets_.push_back(id);
+  }
   return Status::ok;
 }
 
@@ -414,7 +427,7 @@ std::vector<GraspWorker::JobMember> GraspSession::sceneInBox(Hand side, const Po
     c.member.target = h.target;
     c.member.objectFromHand = h.worldFromObject.inverse() * worldFromWrist;
     c.member.graspable = t.role == TargetRole::graspable && t.hands[size_t(side)];
-    c.rank = h.target == held ? 0 : (!t.meshTarget && !t.shapeTarget ? 1 : 2);
+    c.rank = h.target == held ? 0 : (!onCpu(t) ? 1 : 2);
     const glm::vec3 centre =
         t.shapeTarget && !t.shape->bounded()
             ? glm::vec3(0.0f)
@@ -530,12 +543,14 @@ Status GraspSession::solve(HandState& hand, size_t slot,
   hand.members = members;
   const uint64_t id = members[0].target;
   const Target& first = targets_.at(id);
-  const bool device = !first.meshTarget && !first.shapeTarget;
+  const bool device = !onCpu(first);
   // The deferred (GPU) backend builds one mesh: a device target (first in the scene when there is
-  // one; the worker merges the rest on the CPU), or a mesh target alone when meshes go there too.
+  // one; the worker merges the rest on the CPU), or a mesh target alone when meshes go there too
+  // (a device target's readback among them: built from that copy, so that its field and its
+  // exact distance are of the same vertices).
   const bool onDevice =
-      deferredUsable() &&
-      (device || (first.meshTarget && deferredForMeshTargets_ && members.size() == 1));
+      deferredUsable() && (device || (first.deviceCopy.positions != nullptr &&
+                                      deferredForMeshTargets_ && members.size() == 1));
   if (onDevice && !deferredReady()) {
     // Still preparing (pipelines made at session start): a device target waits for it, asked
     // again at the next update; a target with a CPU mesh is built on the CPU below rather than
@@ -563,10 +578,8 @@ Status GraspSession::solve(HandState& hand, size_t slot,
     stats_.gpuFailed = true;  // the device failed: this and every later build on the CPU
   }
   // On the CPU, device targets (no CPU mesh) cannot take part.
-  std::erase_if(members, [&](const GraspWorker::JobMember& m) {
-    const Target& t = targets_.at(m.target);
-    return !t.meshTarget && !t.shapeTarget;
-  });
+  std::erase_if(members,
+                [&](const GraspWorker::JobMember& m) { return !onCpu(targets_.at(m.target)); });
   if (members.empty()) return Status::device_lost;
   post(hand, slot, std::move(members), std::nullopt, false, hand.frameTime);
   return Status::ok;
@@ -606,10 +619,8 @@ Status GraspSession::collect(HandState& hand, size_t slot) {
   }
   // The device failed (or lost the request): the worker redoes the build on the CPU now.
   if (p == BuildPoll::failed) stats_.gpuFailed = true;
-  std::erase_if(members, [&](const GraspWorker::JobMember& m) {
-    const Target& t = targets_.at(m.target);
-    return !t.meshTarget && !t.shapeTarget;
-  });
+  std::erase_if(members,
+                [&](const GraspWorker::JobMember& m) { return !onCpu(targets_.at(m.target)); });
   if (members.empty()) {
     hand.grasp = HandGrasp{};
     return Status::device_lost;
@@ -639,7 +650,9 @@ Status GraspSession::update(Hand side, const HandFrame& tracked,
   HandState& hand = hands_[slot];
   hand.squeeze = std::isfinite(tracked.squeeze) ? tracked.squeeze : 0.0f;
   hand.frameTime = tracked.time;
+  if (tracked.valid) hand.lastWrist = tracked.worldFromWrist;
   refreshSetups();
+  collectReadbacks();
   const Status jobStatus = collectJob(hand, slot);
   Status collected = jobStatus == Status::ok ? collect(hand, slot) : jobStatus;
   // A grasp that ends this frame ends before the outer hand looks: the object let go is scene

@@ -199,9 +199,27 @@ class GraspSession {
   // the app's Vulkan buffers). `bounds` (target frame) must contain the mesh at all times; it
   // decides whether the target is in a grab box. Errors: invalid_argument (id in use, bad
   // bounds), unsupported (no working deferred backend or it has no mesh `id`).
+  // Where the backend reads meshes back (DeferredSdfBackend::requestReadback), the device mesh
+  // is read back at once and set up on the worker like a CPU mesh: from then on the target is a
+  // mesh like any other (exact stops and contacts, a member of scenes, the outer hand sees it),
+  // built on the GPU from that copy, and every change the owner reports (touchTarget) is read
+  // back again while the target is within kReadbackReach of a hand (farther, when it comes
+  // near). What the hands see of a deforming device mesh is then one readback behind the app's
+  // last write: a frame or two. Until its first readback is set up (or where there is none) it
+  // takes part through the GPU's grab-box field only, as members[0] of a scene.
   Status addDeviceTarget(uint64_t id, const Aabb& bounds);
-  // The mesh of a device target changed in place: a hand holding it re-solves.
+  // The mesh of a device target changed in place: a hand holding it re-solves (once the
+  // readback of the change is in, for a target that has one).
   Status touchTarget(uint64_t id);
+  // What readbacks found since the last call, one sentence per target for the owner to log: a
+  // mesh the worker refused (the target goes on through its grab-box field only), triangles
+  // left out because the device could not give their indices.
+  std::vector<std::pair<uint64_t, std::string>> takeReadbackNotes();
+  // Whether device target `id` has its read-back mesh set up (a mesh like any other now).
+  bool readBack(uint64_t id) const;
+  // How far from a hand (metres, wrist to the target's bounds) a device target's changes are
+  // read back as they happen.
+  static constexpr float kReadbackReach = 0.5f;
   // New bounds of a device target (see addDeviceTarget). Errors: invalid_argument.
   Status updateTargetBounds(uint64_t id, const Aabb& bounds);
   // New positions, same count; a hand holding the target re-solves at its next update.
@@ -289,9 +307,18 @@ class GraspSession {
   float lastSqueeze(Hand hand) const { return hands_[size_t(hand)].squeeze; }
 
  private:
+  // A device target's copy on the CPU (addDeviceTarget): none (no readback on this backend),
+  // asked (the first readback is on its way), settingUp (on the worker), ready (a mesh like any
+  // other), failed (the worker refused it: the field only).
+  enum class Mirror { none, asked, settingUp, ready, failed };
   struct Target {
-    bool meshTarget = false;   // CPU arrays (addTarget), not device buffers
-    bool shapeTarget = false;  // an analytic shape (addShapeTarget)
+    bool meshTarget = false;    // CPU arrays (addTarget), not device buffers
+    bool shapeTarget = false;   // an analytic shape (addShapeTarget)
+    bool deviceTarget = false;  // the deferred backend's mesh (addDeviceTarget)
+    Mirror mirror = Mirror::none;
+    uint64_t readbackAsked = 0;    // generation of the newest readback asked
+    uint64_t readbackApplied = 0;  // generation of the newest one handed to the worker
+    bool readbackStale = false;    // changed since, while far from every hand
     std::optional<AnalyticShape> shape;
     TargetRole role = TargetRole::graspable;
     // Where it is (placeTarget); in the broad phase while placed, set up and not ignored.
@@ -349,6 +376,7 @@ class GraspSession {
     bool decided = false;
     // The deferred build's scene (members[0] is the target it builds).
     std::vector<GraspWorker::JobMember> pendingMembers;
+    std::optional<Pose> lastWrist;  // world, at the last update with a valid hand (readbacks)
     struct Outer {
       bool engaged = false;      // jobs posted since the last reset
       uint64_t ticket = 0;       // of the last job posted
@@ -356,6 +384,16 @@ class GraspSession {
       OuterView view;
     } outer;
   };
+  // Whether the worker has the target's distance on the CPU (a mesh, a shape, or a device
+  // target's readback): the exact check, the choice and the outer hand see only these.
+  static bool onCpu(const Target& t) {
+    return t.meshTarget || t.shapeTarget || t.mirror == Mirror::ready;
+  }
+  // Readbacks (grasp_session_readback.cpp): asks for one of the target's mesh; takes those that
+  // arrived and the worker's set-ups of them; asks for the stale ones now near a hand.
+  void askReadback(uint64_t id, Target& t);
+  void collectReadbacks();
+  bool nearHand(uint64_t id, const Target& t) const;
   // The outer hand's part of an update (grasp_session_outer.cpp): takes its newest result,
   // decides the frame's fallback, posts the frame's job, and returns the hand where it is shown
   // (`frame` moved by the fallback; its tracked joints copied to `moved`).
@@ -407,6 +445,10 @@ class GraspSession {
   size_t failedSetups_ = 0;
   std::array<HandState, 2> hands_;
   std::vector<std::pair<uint64_t, std::string>> setupFailures_;
+  std::vector<uint64_t> mirrorSetups_;  // device targets whose readback the worker sets up
+  std::vector<uint64_t> staleTargets_;  // device targets changed while far from every hand
+  uint64_t readbackGeneration_ = 0;
+  std::vector<std::pair<uint64_t, std::string>> readbackNotes_;
   std::unique_ptr<GraspWorker> worker_;  // last: joined before anything it could reach goes
 };
 

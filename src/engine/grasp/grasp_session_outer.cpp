@@ -33,8 +33,8 @@ void GraspSession::outerMembers(const glm::vec3& centre, float half, uint64_t he
     if (it == targets_.end() || it->second.setup != TargetSetup::ready ||
         it->second.role == TargetRole::ignored)
       continue;
-    // Device targets have no CPU distance: the outer hand cannot see them.
-    if (!it->second.meshTarget && !it->second.shapeTarget) continue;
+    // A device target before its readback is set up has no CPU distance: not seen yet.
+    if (!onCpu(it->second)) continue;
     GraspWorker::JobMember m;
     m.target = h.target;
     m.objectFromHand = h.worldFromObject.inverse();  // maps world points (OuterJob::members)

@@ -1,5 +1,6 @@
 #include "sdf/deferred_mailbox.h"
 
+#include <algorithm>
 #include <exception>
 #include <utility>
 
@@ -32,6 +33,10 @@ class DeferredMailbox::OwnerSide final : public DeferredSdfBackend {
   void cancel(size_t slot) override { mailbox_->cancel(slot); }
   bool failed() const override { return mailbox_->failed(); }
   bool ready() override { return mailbox_->ready(); }
+  Status requestReadback(uint64_t id, uint64_t generation) override {
+    return mailbox_->requestReadback(id, generation);
+  }
+  std::vector<MeshReadback> takeReadbacks() override { return mailbox_->takeReadbacks(); }
 
  private:
   std::shared_ptr<DeferredMailbox> mailbox_;
@@ -124,10 +129,25 @@ bool DeferredMailbox::hasDeviceMesh(uint64_t id) const {
 bool DeferredMailbox::needsSubmit() const {
   std::lock_guard lock(mutex_);
   if (failed_) return false;
-  if (deviceNeedsSubmit_) return true;
+  if (deviceNeedsSubmit_ || !readbackRequests_.empty()) return true;
   for (const Slot& s : slots_)
     if (s.queued) return true;
   return false;
+}
+
+Status DeferredMailbox::requestReadback(uint64_t id, uint64_t generation) {
+  std::lock_guard lock(mutex_);
+  if (failed_) return Status::device_lost;
+  if (deviceMeshes_.count(id) == 0) return Status::invalid_argument;
+  if (readbackUnsupported_) return Status::unsupported;
+  uint64_t& wanted = readbackRequests_[id];
+  wanted = std::max(wanted, generation);
+  return Status::ok;
+}
+
+std::vector<MeshReadback> DeferredMailbox::takeReadbacks() {
+  std::lock_guard lock(mutex_);
+  return std::exchange(readbacks_, {});
 }
 
 bool DeferredMailbox::failed() const {
@@ -241,6 +261,10 @@ bool DeferredMailbox::pump(bool sharedQueueFree) {
   claim.emplace(*this);
   posted = std::move(posted_);
   posted_.clear();
+  std::map<uint64_t, uint64_t> readbackRequests = std::move(readbackRequests_);
+  readbackRequests_.clear();
+  std::vector<MeshReadback> readbacks;
+  bool readbackUnsupported = false;
   for (size_t i = 0; i < kSlots; ++i) {
     Slot& s = slots_[i];
     cancels[i] = std::exchange(s.cancel, false);
@@ -264,6 +288,12 @@ bool DeferredMailbox::pump(bool sharedQueueFree) {
       device.cancel(i);
     }
     ready = device.ready();
+    // After the posted calls: a readback asked after new buffers were posted reads those.
+    for (auto it = readbackRequests.begin(); it != readbackRequests.end();) {
+      const Status st = device.requestReadback(it->first, it->second);
+      readbackUnsupported = readbackUnsupported || st == Status::unsupported;
+      it = readbackRequests.erase(it);
+    }
     for (size_t i = 0; i < kSlots; ++i) {
       Seen& v = seen[i];
       if (!v.request) continue;
@@ -280,6 +310,7 @@ bool DeferredMailbox::pump(bool sharedQueueFree) {
       v.poll = device.poll(i, v.grid);
       v.polled = true;
     }
+    readbacks = device.takeReadbacks();
     needsSubmit = device.needsSubmit(true);
     finished = true;
   } catch (...) {
@@ -308,6 +339,13 @@ bool DeferredMailbox::pump(bool sharedQueueFree) {
     if (cancels[i] && !cancelled[i] && s.onDevice) s.cancel = true;
   }
   failed_ = failed_ || failed;
+  readbackUnsupported_ = readbackUnsupported_ || readbackUnsupported;
+  for (MeshReadback& r : readbacks) readbacks_.push_back(std::move(r));
+  // Requests a device call's exception kept from being handed over: again at the next pump.
+  for (const auto& [id, generation] : readbackRequests) {
+    uint64_t& wanted = readbackRequests_[id];
+    wanted = std::max(wanted, generation);
+  }
   if (finished) ready_ = ready;
   deviceNeedsSubmit_ = needsSubmit;
   if (thrown) {

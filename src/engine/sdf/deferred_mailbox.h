@@ -30,6 +30,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -137,6 +138,10 @@ class DeferredMailbox {
   bool needsSubmit() const;
   bool failed() const;
   bool ready() const;
+  // Readbacks of device meshes (DeferredSdfBackend::requestReadback): asked here, handed to the
+  // device by the next pump, and what it finished kept for the owner's takeReadbacks().
+  Status requestReadback(uint64_t id, uint64_t generation);
+  std::vector<MeshReadback> takeReadbacks();
 
   // Waits (with `lock` released) until no other thread holds the device, at most claimWait_, and
   // takes it into `claim` when the answer is done.
@@ -160,6 +165,9 @@ class DeferredMailbox {
   bool failed_ = false;
   bool ready_ = false;
   bool deviceNeedsSubmit_ = false;
+  std::map<uint64_t, uint64_t> readbackRequests_;  // id -> newest generation asked
+  std::vector<MeshReadback> readbacks_;            // finished, for the owner
+  bool readbackUnsupported_ = false;               // the device said it cannot
 
   // The mesh each slot's last request handed the device (assemble()). Only the thread that holds
   // the device touches it.

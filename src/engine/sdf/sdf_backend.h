@@ -53,6 +53,17 @@ struct SharedMesh {
   std::shared_ptr<const std::vector<uint32_t>> indices;
 };
 
+// A device mesh read back to the CPU (DeferredSdfBackend::requestReadback): the vertices (a
+// position the device's buffer does not hold reads as NaN) and, when they were read too, the
+// indices (an index the buffer does not hold reads as UINT32_MAX). The CPU's mesh checks refuse
+// both, so a bad description ends as a refused set-up, never as a read out of bounds.
+struct MeshReadback {
+  uint64_t id = 0;
+  uint64_t generation = 0;  // the requester's, echoed
+  std::vector<glm::vec3> positions;
+  std::vector<uint32_t> indices;  // empty: positions only
+};
+
 // A backend that builds on a device queue its owner may use only at certain moments (the app's
 // Vulkan queue, which the layer may touch only inside xrBeginFrame / xrEndFrame). request()
 // records a build and returns at once; submit() hands every recorded build to the device and
@@ -103,6 +114,19 @@ class DeferredSdfBackend {
   // answers false until that is done, advancing it without waiting; its owner builds on the CPU
   // meanwhile. A failure of the preparation shows in failed().
   virtual bool ready() { return true; }
+
+  // Reads device mesh `id` (hasDeviceMesh) back to CPU arrays at the next submit() that may use
+  // the queue the app writes it on, as it is then; a newer request for the same id replaces one
+  // not yet started. The indices come along the first time and whenever the mesh was registered
+  // again with other index buffers. Errors: invalid_argument (no such mesh), unsupported (this
+  // backend cannot read meshes back: the default), device_lost (failed).
+  virtual Status requestReadback(uint64_t id, uint64_t generation) {
+    (void)id;
+    (void)generation;
+    return Status::unsupported;
+  }
+  // The readbacks finished since the last call, oldest first; never waits.
+  virtual std::vector<MeshReadback> takeReadbacks() { return {}; }
 };
 
 }  // namespace sdfg

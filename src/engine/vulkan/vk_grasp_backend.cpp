@@ -1,12 +1,30 @@
 #include "vulkan/vk_grasp_backend.h"
 
+#include <algorithm>
 #include <iostream>
+#include <utility>
 
 namespace sdfg {
 
 namespace {
 constexpr uint64_t kDestroyWaitNs = 2'000'000'000ull;
+
+// The gatherer of buffer targets' meshes. Its failure costs the readbacks only (buffer targets
+// then take part through their grab-box field alone, as before readbacks): said once, not fatal.
+std::unique_ptr<VkMeshReadback> makeReadback(const VulkanDevice& appQueue,
+                                             const std::function<void(const std::string&)>& log) {
+  auto made = VkMeshReadback::create(appQueue, log);
+  if (made) return std::move(made.value());
+  const std::string line = "sdfg: buffer targets' meshes cannot be read back (" +
+                           made.error().message +
+                           "): they take part in grasps through their grab-box field only";
+  if (log)
+    log(line);
+  else
+    std::cerr << line << std::endl;
+  return nullptr;
 }
+}  // namespace
 
 Result<std::unique_ptr<VkSdfBuilder>> VkGraspBackend::makeBuilder(const VulkanDevice& device) {
   VkSdfOptions options;
@@ -36,6 +54,8 @@ Result<std::unique_ptr<VkGraspBackend>> VkGraspBackend::create(
     slot.main.builder = std::move(builder.value());
     slot.main.shared = ownQueue == nullptr;
   }
+  b->readback_ = makeReadback(appQueue, options.log);
+  b->readbackUnavailable_ = b->readback_ == nullptr;
   return b;
 }
 
@@ -56,6 +76,7 @@ void VkGraspBackend::prepare(VulkanDevice mainQueue, bool appBuilders) {
     }
     made.app[i] = std::move(app.value());
   }
+  if (!made.error && !cancelPrep_.load()) made.readback = makeReadback(appQueue_, options_.log);
   {
     std::lock_guard lock(prepMutex_);
     made_ = std::move(made);
@@ -86,6 +107,8 @@ void VkGraspBackend::adoptPrepared() {
       slots_[i].app.warmups = 0;
     }
   }
+  readback_ = std::move(made.readback);
+  readbackUnavailable_ = readback_ == nullptr;
   prep_ = Prep::warming;
 }
 
@@ -148,6 +171,7 @@ VkGraspBackend::~VkGraspBackend() {
   // adopted are destroyed with made_.
   cancelPrep_.store(true);
   if (preparer_.joinable()) preparer_.join();
+  readback_.reset();  // waits for its gather in flight
   // Each builder's destructor waits for its submission in flight before freeing anything.
   for (Slot& slot : slots_) {
     slot.main.builder.reset();
@@ -227,6 +251,7 @@ Status VkGraspBackend::request(size_t slot, uint64_t id, uint64_t version, const
 bool VkGraspBackend::needsSubmit(bool sharedQueueFree) const {
   if (failed_) return false;
   if (prep_ == Prep::making) return prepared_.load(std::memory_order_acquire);
+  if (!readbackWanted_.empty() && readback_ != nullptr && sharedQueueFree) return true;
   if (prep_ == Prep::warming) {
     for (const Slot& s : slots_) {
       for (const Builder* b : {&s.main, &s.app}) {
@@ -248,6 +273,7 @@ Status VkGraspBackend::submit(bool sharedQueueFree) {
     adoptPrepared();
     if (failed_) return Status::device_lost;
   }
+  pumpReadbacks(sharedQueueFree);
   if (prep_ == Prep::warming) return submitWarmups(sharedQueueFree);
   for (Slot& s : slots_) {
     if (!s.recorded || (s.active->shared && !sharedQueueFree)) continue;
@@ -321,9 +347,65 @@ Status VkGraspBackend::setDeviceMesh(uint64_t id, const VkMeshBuffers& buffers) 
     }
   }
   auto [it, inserted] = deviceMeshes_.try_emplace(id);
-  if (!inserted) ++it->second.version;
+  if (!inserted) {
+    ++it->second.version;
+    const VkMeshBuffers& was = it->second.buffers;
+    // Other index buffers (a new description, not new vertices): a readback brings them again.
+    if (was.indices != buffers.indices || was.indexOffset != buffers.indexOffset ||
+        was.indexType != buffers.indexType || was.indexCount != buffers.indexCount)
+      it->second.indicesRead = false;
+  }
   it->second.buffers = buffers;
   return Status::ok;
+}
+
+Status VkGraspBackend::requestReadback(uint64_t id, uint64_t generation) {
+  if (failed_) return Status::device_lost;
+  if (deviceMeshes_.count(id) == 0) return Status::invalid_argument;
+  if (readbackUnavailable_ || (readback_ != nullptr && readback_->failed()))
+    return Status::unsupported;
+  // Kept until the preparation has made the gatherer (readback_ null meanwhile).
+  auto [it, inserted] = readbackWanted_.try_emplace(id, generation);
+  if (inserted)
+    readbackOrder_.push_back(id);
+  else
+    it->second = std::max(it->second, generation);
+  return Status::ok;
+}
+
+void VkGraspBackend::collectReadback() {
+  if (readback_ == nullptr || !readback_->busy()) return;
+  std::optional<MeshReadback> done = readback_->poll();
+  if (!done) return;
+  auto it = deviceMeshes_.find(done->id);
+  if (it == deviceMeshes_.end()) return;  // removed meanwhile
+  if (!done->indices.empty()) it->second.indicesRead = true;
+  readbacksDone_.push_back(std::move(*done));
+}
+
+void VkGraspBackend::pumpReadbacks(bool sharedQueueFree) {
+  if (readback_ == nullptr) return;
+  collectReadback();
+  // The app's queue only: its writes to the buffers are ordered before the gather by submission
+  // order there.
+  while (sharedQueueFree && !readback_->busy() && !readback_->failed() && !readbackOrder_.empty()) {
+    const uint64_t id = readbackOrder_.front();
+    readbackOrder_.pop_front();
+    auto wanted = readbackWanted_.find(id);
+    auto mesh = deviceMeshes_.find(id);
+    if (wanted == readbackWanted_.end()) continue;
+    const uint64_t generation = wanted->second;
+    readbackWanted_.erase(wanted);
+    if (mesh == deviceMeshes_.end()) continue;
+    // A description the gather refuses is refused at registration already; a device failure
+    // leaves readback_ failed and is said by its one log line.
+    (void)readback_->submit(id, generation, mesh->second.buffers, !mesh->second.indicesRead);
+  }
+}
+
+std::vector<MeshReadback> VkGraspBackend::takeReadbacks() {
+  collectReadback();
+  return std::exchange(readbacksDone_, {});
 }
 
 bool VkGraspBackend::removeDeviceMesh(uint64_t id) {
@@ -348,6 +430,13 @@ bool VkGraspBackend::removeDeviceMesh(uint64_t id) {
       b->meshOnDevice = false;
     }
   }
+  // A gather of its buffers in flight ends first too; its result is dropped.
+  if (readback_ != nullptr && readback_->busyWith() == id) {
+    (void)readback_->wait(kDestroyWaitNs);
+    if (readback_->busy() && !readback_->failed()) return false;
+  }
+  std::erase_if(readbacksDone_, [&](const MeshReadback& r) { return r.id == id; });
+  readbackWanted_.erase(id);
   deviceMeshes_.erase(id);
   return true;
 }

@@ -28,6 +28,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -37,6 +38,7 @@
 #include <unordered_map>
 
 #include "sdf/sdf_backend.h"
+#include "vulkan/vk_mesh_readback.h"
 #include "vulkan/vk_sdf_builder.h"
 
 namespace sdfg {
@@ -77,6 +79,9 @@ class VkGraspBackend final : public DeferredSdfBackend {
   void cancel(size_t slot) override;
   bool failed() const override { return failed_; }
   bool ready() override;
+  // Gathers on the app's queue (vulkan/vk_mesh_readback.h), one at a time, in the order asked.
+  Status requestReadback(uint64_t id, uint64_t generation) override;
+  std::vector<MeshReadback> takeReadbacks() override;
 
   // Registers (or replaces) the app-buffer mesh of target `id`. The buffers are borrowed: see
   // VkMeshBuffers. Errors: invalid_argument (see VkSdfBuilder::setMesh(VkMeshBuffers)),
@@ -106,6 +111,7 @@ class VkGraspBackend final : public DeferredSdfBackend {
   // What the preparation thread made, handed over under prepMutex_.
   struct Prepared {
     std::array<std::unique_ptr<VkSdfBuilder>, kSlots> main, app;
+    std::unique_ptr<VkMeshReadback> readback;  // null: readbacks unavailable (logged)
     std::optional<Error> error;
   };
   enum class Prep { making, warming, done };
@@ -122,6 +128,7 @@ class VkGraspBackend final : public DeferredSdfBackend {
   struct DeviceMesh {
     VkMeshBuffers buffers;
     uint64_t version = 1;
+    bool indicesRead = false;  // a readback brought its indices (they come once)
   };
 
   VkGraspBackend() = default;
@@ -134,11 +141,21 @@ class VkGraspBackend final : public DeferredSdfBackend {
   void adoptPrepared();
   // Submits the next warm-up build of each builder whose queue may be used now.
   Status submitWarmups(bool sharedQueueFree);
+  // Collects a finished readback, then starts the next one asked for (app's queue only).
+  void pumpReadbacks(bool sharedQueueFree);
+  void collectReadback();
 
   std::array<Slot, kSlots> slots_;
   VulkanDevice appQueue_{};
   bool ownQueue_ = false;
   std::unordered_map<uint64_t, DeviceMesh> deviceMeshes_;
+  // Readbacks: the gatherer (on the app's queue; null until prepared, or when it could not be
+  // made), the ids asked for in order with their newest generation, and the finished ones.
+  std::unique_ptr<VkMeshReadback> readback_;
+  bool readbackUnavailable_ = false;
+  std::deque<uint64_t> readbackOrder_;
+  std::unordered_map<uint64_t, uint64_t> readbackWanted_;
+  std::vector<MeshReadback> readbacksDone_;
   VkGraspBackendOptions options_;
   VkGraspFault fault_ = VkGraspFault::none;
   bool failed_ = false;

@@ -222,7 +222,9 @@ typedef struct XrGraspBuildInfoSDFG {
 // distance structure (BVH, pseudo-normals) is built on the layer's worker thread, and the target
 // can be grasped only once it is ready (a squeeze before that grabs nothing). A set-up that
 // fails (the mesh was refused, or memory ran out) is logged once and leaves the target never
-// graspable. Vulkan buffer targets are ready at once.
+// graspable. A Vulkan buffer target counts as pending until the layer has read its mesh back
+// and set it up (it can be grasped meanwhile, on its grab-box field); it is ready at once where
+// its mesh cannot be read back.
 typedef struct XrGraspTargetsSetupInfoSDFG {
   XrStructureType type;  // XR_TYPE_GRASP_TARGETS_SETUP_INFO_SDFG
   void* XR_MAY_ALIAS next;

@@ -150,7 +150,8 @@ void GraspSession::refreshSetups() {
 GraspSession::SetupCounts GraspSession::setupCounts() {
   refreshSetups();
   SetupCounts c;
-  c.pending = pendingSetups_.size();
+  collectReadbacks();
+  c.pending = pendingSetups_.size() + mirrorsPending_;
   c.failed = failedSetups_;
   c.ready = targets_.size() - c.pending - c.failed;
   return c;
@@ -376,6 +377,8 @@ bool GraspSession::removeTarget(uint64_t id) {
   auto it = targets_.find(id);
   if (it == targets_.end()) return false;
   if (it->second.setup == TargetSetup::failed) --failedSetups_;
+  if (it->second.mirror == Mirror::asked || it->second.mirror == Mirror::settingUp)
+    --mirrorsPending_;
   targets_.erase(it);
   return true;
 }

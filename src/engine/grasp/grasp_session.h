@@ -188,6 +188,7 @@ class GraspSession {
   // updates is reported once, at its first.
   std::vector<std::pair<uint64_t, std::string>> takeRefusedUpdates();
   // How many targets are set up, still being set up, failed (without a loop over the targets).
+  // A device target counts as being set up until its first readback is (see addDeviceTarget).
   struct SetupCounts {
     size_t ready = 0, pending = 0, failed = 0;
   };
@@ -448,6 +449,7 @@ class GraspSession {
   std::vector<uint64_t> mirrorSetups_;  // device targets whose readback the worker sets up
   std::vector<uint64_t> staleTargets_;  // device targets changed while far from every hand
   uint64_t readbackGeneration_ = 0;
+  size_t mirrorsPending_ = 0;  // device targets whose first readback is not set up yet
   std::vector<std::pair<uint64_t, std::string>> readbackNotes_;
   std::unique_ptr<GraspWorker> worker_;  // last: joined before anything it could reach goes
 };

@@ -15,12 +15,18 @@ void GraspSession::askReadback(uint64_t id, Target& t) {
   const Status s = deferred_->requestReadback(id, generation);
   if (s != Status::ok) {
     // No readback on this backend (or the device failed): the field only, as before readbacks.
-    if (t.mirror == Mirror::asked) t.mirror = Mirror::none;
+    if (t.mirror == Mirror::asked) {
+      t.mirror = Mirror::none;
+      --mirrorsPending_;
+    }
     return;
   }
   t.readbackAsked = generation;
   t.readbackStale = false;
-  if (t.mirror == Mirror::none) t.mirror = Mirror::asked;
+  if (t.mirror == Mirror::none) {
+    t.mirror = Mirror::asked;
+    ++mirrorsPending_;
+  }
 }
 
 bool GraspSession::nearHand(uint64_t id, const Target& t) const {
@@ -103,11 +109,13 @@ void GraspSession::collectReadbacks() {
     GraspWorker::TargetInfo info = worker_->targetInfo(id);
     if (info.setup == TargetSetup::ready) {
       t.mirror = Mirror::ready;
+      --mirrorsPending_;
       ++t.version;  // a hand holding it solves again, now with its exact distance
       if (t.deviceCopy.indices != nullptr && info.orientedIndices != nullptr)
         t.deviceCopy.indices = info.orientedIndices;
     } else if (info.setup == TargetSetup::failed) {
       t.mirror = Mirror::failed;
+      --mirrorsPending_;
       t.deviceCopy = SharedMesh{};
       worker_->removeTarget(id);
       readbackNotes_.emplace_back(

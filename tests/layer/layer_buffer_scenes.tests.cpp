@@ -1,0 +1,244 @@
+// Buffer targets (XrGraspTargetVulkanBuffersSDFG) in scenes, through the loader on lavapipe with
+// the Khronos Vulkan validation layer: the layer reads their mesh back and sets it up as it does
+// a CPU mesh, so a box in the app's buffers lying on a table is taken, named by the touches,
+// stopped on exactly, kept out of the table, followed when the app rewrites it, and kept out of
+// an open hand that reaches into it (the outer hand).
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "buffer_mesh.h"
+#include "grasp_checks.h"
+#include "grasp_v2.h"
+#include "scene/analytic_shape.h"
+
+namespace {
+
+using namespace sdfg;
+using namespace sdfg::test;
+
+const XrPosef kGrip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
+// The 6 x 3 x 10 cm box, lying with its 3 cm toward the palm.
+const XrVector3f kHalf{0.03f, 0.015f, 0.05f};
+const XrVector3f kTableHalf{0.3f, 0.02f, 0.3f};
+// How much lower than belowOpenRightPalm() the box lies so that every located joint's sphere of
+// the open hand is clear of it (that function clears the model's finger and palm spheres; the
+// thumb's metacarpal joint sphere reaches 8 mm farther).
+constexpr float kClear = 0.011f;
+
+XrPosef awayFromPalm(XrPosef p, float d) {
+  const glm::vec3 down = openRightHand(kGrip).down;
+  p.position = {p.position.x + down.x * d, p.position.y + down.y * d, p.position.z + down.z * d};
+  return p;
+}
+
+AnalyticShape boxShape(const XrVector3f& half, float scale = 1.0f) {
+  return AnalyticShape{ShapeKind::box, scale * glm::vec3(half.x, half.y, half.z)};
+}
+
+// A Vulkan app (XR_KHR_vulkan_enable2, the GPU path on) with a controller-only right hand at kGrip
+// and the box in its buffers lying on a table under the palm (the table an analytic box, or a
+// mesh given as arrays, role SCENE).
+struct BufferScene {
+  std::unique_ptr<App> app;
+  std::unique_ptr<Ext> ext;
+  XrHandTrackerEXT tracker = XR_NULL_HANDLE;
+  TestMesh mesh = toTestMesh(makeBox(2.0f * glm::vec3(kHalf.x, kHalf.y, kHalf.z)));
+  BufferMesh buffers;
+  XrPosef boxPose{};
+  XrPosef tablePose{};
+  XrGraspTargetSDFG box = XR_NULL_HANDLE;
+  XrGraspTargetSDFG table = XR_NULL_HANDLE;
+
+  // `lower`: the box (and table) that much farther from the palm than where the open hand's
+  // model spheres are 3 mm clear of it (the located joints' spheres reach a little farther).
+  explicit BufferScene(bool meshTable, bool withTable = true, float lower = 0.0f) {
+    XrEnv env;
+    env.handTracking = "absent";
+    env.extra = {{"SDFG_AUTOGRASP_GPU", "on"}};
+    env.script = gripLine(0, "right", kGrip) + squeezeLine(0, "right", 0.0f);
+    applyEnv(env);
+    app = std::make_unique<App>(
+        AppOptions{{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME},
+                   true,
+                   Graphics::vulkan2});
+    REQUIRE(app->ok());
+    ext = std::make_unique<Ext>(*app);
+    tracker = makeTracker(*app, *ext, XR_HAND_RIGHT_EXT);
+    boxPose = awayFromPalm(belowOpenRightPalm(mesh, kGrip, facingPalm(kGrip)), lower);
+    buffers = uploadMesh(*app, mesh, 1.0f);
+    XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &buffers.desc};
+    ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, app->local, boxPose};
+    REQUIRE(ext->create(app->session, &ci, &box) == XR_SUCCESS);
+    int targets = 1;
+    if (withTable) {
+      // The table's top touches the box's underside: the box rests on it.
+      tablePose = awayFromPalm(boxPose, kHalf.y + kTableHalf.y);
+      if (meshTable) {
+        table = makeTarget(*app, *ext, toTestMesh(makeBox(2.0f * glm::vec3(0.3f, 0.02f, 0.3f))),
+                           tablePose);
+        auto set = app->fn<PFN_xrSetGraspTargetSettingsSDFG>("xrSetGraspTargetSettingsSDFG");
+        XrGraspTargetRoleInfoSDFG r{XR_TYPE_GRASP_TARGET_ROLE_SDFG, nullptr,
+                                    XR_GRASP_TARGET_ROLE_SCENE_SDFG};
+        XrGraspTargetSettingsSDFG s{XR_TYPE_GRASP_TARGET_SETTINGS_SDFG, &r,
+                                    XR_GRASP_HAND_LEFT_BIT_SDFG | XR_GRASP_HAND_RIGHT_BIT_SDFG};
+        REQUIRE(set(table, &s) == XR_SUCCESS);
+      } else {
+        table = makeShapeTarget(*app, *ext, XR_GRASP_SHAPE_TYPE_BOX_SDFG, kTableHalf, tablePose,
+                                XR_GRASP_TARGET_ROLE_SCENE_SDFG);
+      }
+      ++targets;
+    }
+    // The buffer target counts as pending until its mesh is read back and set up.
+    REQUIRE(runUntil(*app, [&] {
+      const XrGraspTargetsSetupInfoSDFG s = setupInfo(*app, *ext);
+      return s.readyCount == uint32_t(targets) && s.pendingCount == 0;
+    }));
+  }
+
+  void squeezeNow() const {
+    REQUIRE(app->setScript(gripLine(0, "right", kGrip) + squeezeLine(0, "right", 0.0f) +
+                           squeezeLine(app->framesEnded + 1, "right", 1.0f)) == XR_SUCCESS);
+  }
+
+  struct State {
+    XrGraspStateSDFG state{XR_TYPE_GRASP_STATE_SDFG};
+    XrGraspTouchesSDFG touches{XR_TYPE_GRASP_TOUCHES_SDFG};
+    XrGraspContactsSDFG contacts{XR_TYPE_GRASP_CONTACTS_SDFG};
+  };
+  State state() const {
+    State s;
+    s.state.next = &s.touches;
+    s.touches.next = &s.contacts;
+    XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
+    REQUIRE(ext->state(app->session, &gi, &s.state) == XR_SUCCESS);
+    return s;
+  }
+  Joints joints() const {
+    Joints j;
+    REQUIRE(locateJoints(*app, tracker, j) == XR_SUCCESS);
+    return j;
+  }
+};
+
+// Every finger that touches the box has an exact contact whose distance is the box's (scaled
+// by `scale`) signed distance at the contact sphere's centre, within `tolerance`.
+bool exactOnBox(const BufferScene::State& s, XrGraspTargetSDFG box, float scale, float tolerance) {
+  if (!s.state.isGrasping || s.state.target != box) return false;
+  int touching = 0;
+  for (int f = 0; f < 5; ++f) {
+    if (s.touches.touched[f] != box) continue;
+    const XrGraspFingerContactSDFG& c = s.contacts.fingers[f];
+    if (!c.isExact) return false;
+    const glm::vec3 p(c.sphereCenter.x, c.sphereCenter.y, c.sphereCenter.z);
+    if (std::abs(boxShape(kHalf, scale).signedDistance(p) - c.distance) > tolerance) return false;
+    ++touching;
+  }
+  return touching >= 1;
+}
+
+}  // namespace
+
+TEST_CASE("A box in the app's buffers lying on a table is taken and stopped on as a CPU mesh is",
+          "[layer][vulkan][scenes]") {
+  if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  const bool meshTable = GENERATE(false, true);
+  CAPTURE(meshTable);
+  const size_t messagesBefore = vulkanMessages().size();
+  {
+    BufferScene scene(meshTable, true, kClear);
+    scene.squeezeNow();
+    REQUIRE(
+        runUntil(*scene.app, [&] { return exactOnBox(scene.state(), scene.box, 1.0f, 1e-4f); }));
+    const BufferScene::State s = scene.state();
+    // Taken, and named by the fingers on it (each finger names what it touches).
+    CHECK(s.state.target == scene.box);
+    std::map<XrGraspTargetSDFG, int> on;
+    for (XrGraspTargetSDFG t : s.touches.touched)
+      if (t != XR_NULL_HANDLE) ++on[t];
+    CHECK(on[scene.box] >= 1);
+    for (const auto& [t, n] : on) CHECK((t == scene.box || t == scene.table));
+    // No hand part in the table, none in the box past the exact stop's 0.5 mm.
+    const Joints j = scene.joints();
+    CHECK(depthInBox(j, boxShape(kTableHalf), scene.tablePose) <= 0.001f);
+    CHECK(depthInBox(j, boxShape(kHalf), scene.boxPose) <= 0.0005f);
+  }
+  CHECK(validationLog().empty());
+  CHECK(vulkanMessages().size() == messagesBefore);
+}
+
+TEST_CASE("A box in the app's buffers held on a table follows what the app writes into them",
+          "[layer][vulkan][scenes]") {
+  if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  const size_t messagesBefore = vulkanMessages().size();
+  {
+    BufferScene scene(/*meshTable=*/false, true, kClear);
+    scene.squeezeNow();
+    REQUIRE(
+        runUntil(*scene.app, [&] { return exactOnBox(scene.state(), scene.box, 1.0f, 1e-4f); }));
+    auto update =
+        scene.app->fn<PFN_xrUpdateGraspTargetVerticesSDFG>("xrUpdateGraspTargetVerticesSDFG");
+    // The box grows about its centre in two steps (a skinned mesh's new poses), into the hand. Each
+    // step is written while nothing of the GPU reads the buffers (the hand holds still, and the
+    // last readback is in), then said with an update; the held grasp follows once it is read back.
+    for (const float scale : {1.05f, 1.1f}) {
+      CAPTURE(scale);
+      writeVertices(scene.buffers, scene.mesh, scale);
+      REQUIRE(update(scene.box, &scene.buffers.desc) == XR_SUCCESS);
+      REQUIRE(
+          runUntil(*scene.app, [&] { return exactOnBox(scene.state(), scene.box, scale, 1e-4f); }));
+      const Joints j = scene.joints();
+      CHECK(depthInBox(j, boxShape(kHalf, scale), scene.boxPose) <= 0.0005f);
+      CHECK(depthInBox(j, boxShape(kTableHalf), scene.tablePose) <= 0.001f);
+    }
+  }
+  CHECK(validationLog().empty());
+  CHECK(vulkanMessages().size() == messagesBefore);
+}
+
+TEST_CASE("The outer hand keeps an open hand out of a box in the app's buffers it reaches into",
+          "[layer][vulkan][outer_hand]") {
+  if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  const size_t messagesBefore = vulkanMessages().size();
+  {
+    BufferScene scene(/*meshTable=*/false, /*withTable=*/false, /*lower=*/kClear + 0.004f);
+    // Down from 7 mm clear of the box to 1.5 cm into it, 2 mm a frame, then still; squeeze 0;
+    // frames 11 ms apart.
+    const glm::vec3 down = openRightHand(kGrip).down;
+    std::string script = squeezeLine(0, "right", 0.0f);
+    const uint64_t firstFrame = scene.app->framesEnded + 1;
+    const int steps = 11;
+    XrPosef grip = kGrip;
+    for (int k = 0; k <= steps; ++k) {
+      grip.position = {kGrip.position.x + down.x * 0.002f * k,
+                       kGrip.position.y + down.y * 0.002f * k,
+                       kGrip.position.z + down.z * 0.002f * k};
+      script += gripLine(firstFrame + k, "right", grip);
+    }
+    REQUIRE(scene.app->setScript(script) == XR_SUCCESS);
+    float deepest = -1.0f, startDepth = 1.0f;
+    auto next = std::chrono::steady_clock::now();
+    for (int k = 0; k <= steps + 20; ++k) {
+      next += std::chrono::microseconds(11111);
+      std::this_thread::sleep_until(next);
+      Joints j;
+      XrResult located = XR_ERROR_RUNTIME_FAILURE;
+      scene.app->frame([&] { located = locateJoints(*scene.app, scene.tracker, j); });
+      REQUIRE(located == XR_SUCCESS);
+      const float depth = depthInBox(j, boxShape(kHalf), scene.boxPose);
+      if (k == 0) startDepth = depth;
+      deepest = std::max(deepest, depth);
+    }
+    // Clear at the start; the tracked hand ended 1.5 cm inside, the shown one stayed on the box.
+    CHECK(startDepth < 0.0f);
+    CHECK(deepest <= 0.001f);
+  }
+  CHECK(validationLog().empty());
+  CHECK(vulkanMessages().size() == messagesBefore);
+}

@@ -27,6 +27,7 @@ extern "C" size_t __sanitizer_get_current_allocated_bytes();
 #include "sdf/sdf_cpu.h"
 #include "sdf/sdf_grid.h"
 #include "test_support.h"
+#include "vulkan/vk_mesh_readback.h"
 #include "vulkan/vk_sdf_backend.h"
 #include "vulkan/vk_sdf_builder.h"
 #include "vulkan/vk_sdf_builder_detail.h"
@@ -593,6 +594,43 @@ TEST_CASE("Vulkan SDF reads app-owned buffers with stride and offset and 16-bit 
     bad = m;
     bad.positions = VK_NULL_HANDLE;
     CHECK(b.setMesh(bad) == Status::invalid_argument);
+  }
+  SECTION("the mesh read back (vk_mesh_readback.h) is the arrays, and the indices come on ask") {
+    auto made = VkMeshReadback::create(vk->device());
+    REQUIRE(made.ok());
+    VkMeshReadback& r = **made;
+    auto gather = [&](bool withIndices) {
+      REQUIRE(r.submit(7, 11, m, withIndices) == Status::ok);
+      CHECK(r.submit(7, 12, m, withIndices) == Status::unsupported);  // one at a time
+      CHECK(r.busyWith() == 7);
+      std::optional<MeshReadback> got = r.wait(10'000'000'000ull);
+      REQUIRE(got.has_value());
+      CHECK_FALSE(r.busy());
+      CHECK(got->id == 7);
+      CHECK(got->generation == 11);
+      return *got;
+    };
+    const MeshReadback full = gather(true);
+    CHECK(full.positions == torus.positions);
+    CHECK(full.indices == torus.indices);
+    const MeshReadback positions = gather(false);
+    CHECK(positions.positions == torus.positions);
+    CHECK(positions.indices.empty());
+    // A last 16-bit index in the two bytes past the buffer's last whole word cannot be read by
+    // a shader: it reads as UINT32_MAX, which the CPU's checks refuse (never a read out of range).
+    AppBuffer odd(vk->device(), indices.data(), (3 + torus.indices.size()) * 2);
+    VkMeshBuffers cut = m;
+    cut.indices = odd.buffer;
+    if ((3 + torus.indices.size()) % 2 == 1) {
+      REQUIRE(r.submit(8, 1, cut, true) == Status::ok);
+      std::optional<MeshReadback> got = r.wait(10'000'000'000ull);
+      REQUIRE(got.has_value());
+      CHECK(got->indices.back() == UINT32_MAX);
+      CHECK(std::equal(got->indices.begin(), got->indices.end() - 1, torus.indices.begin()));
+    }
+    VkMeshBuffers bad = m;
+    bad.positionStride = 14;
+    CHECK(r.submit(9, 1, bad, true) == Status::invalid_argument);
   }
   SECTION("an index out of range drops its triangle instead of reading past the buffer") {
     std::vector<uint16_t> broken = indices;

@@ -242,3 +242,64 @@ TEST_CASE("The outer hand keeps an open hand out of a box in the app's buffers i
   CHECK(validationLog().empty());
   CHECK(vulkanMessages().size() == messagesBefore);
 }
+
+TEST_CASE("A box in the app's buffers carried down into the table it lay on stays on the table",
+          "[layer][vulkan][outer_hand]") {
+  if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  const size_t messagesBefore = vulkanMessages().size();
+  {
+    BufferScene scene(/*meshTable=*/false, true, kClear);
+    scene.squeezeNow();
+    REQUIRE(
+        runUntil(*scene.app, [&] { return exactOnBox(scene.state(), scene.box, 1.0f, 1e-4f); }));
+    // The hand, still squeezing, goes 2 cm down into the table, 2 mm a frame, frames 11 ms apart.
+    const glm::vec3 down = openRightHand(kGrip).down;
+    std::string script = squeezeLine(0, "right", 1.0f);
+    const uint64_t firstFrame = scene.app->framesEnded + 1;
+    const int steps = 10;
+    for (int k = 0; k <= steps; ++k) {
+      const glm::vec3 d = down * (0.002f * float(k));
+      const XrPosef grip{kGrip.orientation,
+                         {kGrip.position.x + d.x, kGrip.position.y + d.y, kGrip.position.z + d.z}};
+      script += gripLine(firstFrame + k, "right", grip);
+    }
+    REQUIRE(scene.app->setScript(script) == XR_SUCCESS);
+    // Where the app draws the box it carries: the shown palm times palmFromTarget; its corners
+    // against the table's top.
+    const Pose tableFromLocal = toPose(scene.tablePose).inverse();
+    const AnalyticShape table = boxShape(kTableHalf);
+    float deepest = -1.0f;
+    int held = 0;
+    auto next = std::chrono::steady_clock::now();
+    for (int k = 0; k <= steps + 20; ++k) {
+      next += std::chrono::microseconds(11111);
+      std::this_thread::sleep_until(next);
+      Joints j;
+      XrGraspHeldPoseSDFG pose{XR_TYPE_GRASP_HELD_POSE_SDFG};
+      XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG, &pose};
+      XrResult located = XR_ERROR_RUNTIME_FAILURE, state = XR_ERROR_RUNTIME_FAILURE;
+      scene.app->frame([&] {
+        located = locateJoints(*scene.app, scene.tracker, j);
+        XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
+        state = scene.ext->state(scene.app->session, &gi, &st);
+      });
+      REQUIRE(located == XR_SUCCESS);
+      REQUIRE(state == XR_SUCCESS);
+      if (!pose.isValid) continue;
+      ++held;
+      const Pose localFromBox =
+          toPose(j.joints[XR_HAND_JOINT_PALM_EXT].pose) * toPose(pose.palmFromTarget);
+      for (int c = 0; c < 8; ++c) {
+        const glm::vec3 corner((c & 1 ? 1 : -1) * kHalf.x, (c & 2 ? 1 : -1) * kHalf.y,
+                               (c & 4 ? 1 : -1) * kHalf.z);
+        const glm::vec3 p = tableFromLocal.transformPoint(localFromBox.transformPoint(corner));
+        deepest = std::max(deepest, -table.signedDistance(p));
+      }
+    }
+    CHECK(held > steps);  // held all along
+    // The tracked hand carried it 2 cm in; the shown one keeps it on the table.
+    CHECK(deepest <= 0.001f);
+  }
+  CHECK(validationLog().empty());
+  CHECK(vulkanMessages().size() == messagesBefore);
+}

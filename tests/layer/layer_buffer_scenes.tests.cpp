@@ -58,7 +58,9 @@ struct BufferScene {
 
   // `lower`: the box (and table) that much farther from the palm than where the open hand's
   // model spheres are 3 mm clear of it (the located joints' spheres reach a little farther).
-  explicit BufferScene(bool meshTable, bool withTable = true, float lower = 0.0f) {
+  // `across`: the box that far across the fingers from the palm (metres).
+  explicit BufferScene(bool meshTable, bool withTable = true, float lower = 0.0f,
+                       float across = 0.0f) {
     XrEnv env;
     env.handTracking = "absent";
     env.extra = {{"SDFG_AUTOGRASP_GPU", "on"}};
@@ -71,11 +73,11 @@ struct BufferScene {
     REQUIRE(app->ok());
     ext = std::make_unique<Ext>(*app);
     tracker = makeTracker(*app, *ext, XR_HAND_RIGHT_EXT);
-    boxPose = awayFromPalm(belowOpenRightPalm(mesh, kGrip, facingPalm(kGrip)), lower);
+    boxPose = awayFromPalm(
+        belowOpenRightPalm(mesh, kGrip, facingPalm(kGrip), openRightHand(kGrip).across * across),
+        lower);
     buffers = uploadMesh(*app, mesh, 1.0f);
-    XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &buffers.desc};
-    ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, app->local, boxPose};
-    REQUIRE(ext->create(app->session, &ci, &box) == XR_SUCCESS);
+    box = addBuffers(buffers, boxPose);
     int targets = 1;
     if (withTable) {
       // The table's top touches the box's underside: the box rests on it.
@@ -95,7 +97,19 @@ struct BufferScene {
       }
       ++targets;
     }
-    // The buffer target counts as pending until its mesh is read back and set up.
+    waitReady(targets);
+  }
+
+  XrGraspTargetSDFG addBuffers(const BufferMesh& m, const XrPosef& pose) const {
+    XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG, &m.desc};
+    ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, app->local, pose};
+    XrGraspTargetSDFG t = XR_NULL_HANDLE;
+    REQUIRE(ext->create(app->session, &ci, &t) == XR_SUCCESS);
+    return t;
+  }
+
+  // A buffer target counts as pending until its mesh is read back and set up.
+  void waitReady(int targets) const {
     REQUIRE(runUntil(*app, [&] {
       const XrGraspTargetsSetupInfoSDFG s = setupInfo(*app, *ext);
       return s.readyCount == uint32_t(targets) && s.pendingCount == 0;
@@ -141,6 +155,34 @@ bool exactOnBox(const BufferScene::State& s, XrGraspTargetSDFG box, float scale,
     ++touching;
   }
   return touching >= 1;
+}
+
+// The grip script of a hand that goes `steps` frames down along the open palm's normal from
+// kGrip, `step` metres a frame, from the app's next frame on, squeezing `squeeze` throughout.
+std::string reachDown(const App& app, int steps, float step, float squeeze) {
+  const glm::vec3 down = openRightHand(kGrip).down;
+  std::string script = squeezeLine(0, "right", squeeze);
+  for (int k = 0; k <= steps; ++k) {
+    const glm::vec3 d = down * (step * float(k));
+    const XrPosef grip{kGrip.orientation,
+                       {kGrip.position.x + d.x, kGrip.position.y + d.y, kGrip.position.z + d.z}};
+    script += gripLine(app.framesEnded + 1 + uint64_t(k), "right", grip);
+  }
+  return script;
+}
+
+// Runs `frames` frames 11 ms apart (90 Hz); `inFrame()` runs in each between the sync and the
+// frame's end, where an app locates its hands.
+template <class F>
+void pacedFrames(App& app, int frames, F inFrame) {
+  auto next = std::chrono::steady_clock::now();
+  for (int k = 0; k < frames; ++k) {
+    next += std::chrono::microseconds(11111);
+    std::this_thread::sleep_until(next);
+    const uint64_t ended = app.framesEnded;
+    app.frame(inFrame);
+    REQUIRE(app.framesEnded == ended + 1);
+  }
 }
 
 }  // namespace
@@ -208,33 +250,18 @@ TEST_CASE("The outer hand keeps an open hand out of a box in the app's buffers i
   const size_t messagesBefore = vulkanMessages().size();
   {
     BufferScene scene(/*meshTable=*/false, /*withTable=*/false, /*lower=*/kClear + 0.004f);
-    // Down from 7 mm clear of the box to 1.5 cm into it, 2 mm a frame, then still; squeeze 0;
-    // frames 11 ms apart.
-    const glm::vec3 down = openRightHand(kGrip).down;
-    std::string script = squeezeLine(0, "right", 0.0f);
-    const uint64_t firstFrame = scene.app->framesEnded + 1;
+    // Down from 7 mm clear of the box to 1.5 cm into it, 2 mm a frame, then still; squeeze 0.
     const int steps = 11;
-    XrPosef grip = kGrip;
-    for (int k = 0; k <= steps; ++k) {
-      grip.position = {kGrip.position.x + down.x * 0.002f * k,
-                       kGrip.position.y + down.y * 0.002f * k,
-                       kGrip.position.z + down.z * 0.002f * k};
-      script += gripLine(firstFrame + k, "right", grip);
-    }
-    REQUIRE(scene.app->setScript(script) == XR_SUCCESS);
+    REQUIRE(scene.app->setScript(reachDown(*scene.app, steps, 0.002f, 0.0f)) == XR_SUCCESS);
     float deepest = -1.0f, startDepth = 1.0f;
-    auto next = std::chrono::steady_clock::now();
-    for (int k = 0; k <= steps + 20; ++k) {
-      next += std::chrono::microseconds(11111);
-      std::this_thread::sleep_until(next);
+    int k = 0;
+    pacedFrames(*scene.app, steps + 21, [&] {
       Joints j;
-      XrResult located = XR_ERROR_RUNTIME_FAILURE;
-      scene.app->frame([&] { located = locateJoints(*scene.app, scene.tracker, j); });
-      REQUIRE(located == XR_SUCCESS);
+      REQUIRE(locateJoints(*scene.app, scene.tracker, j) == XR_SUCCESS);
       const float depth = depthInBox(j, boxShape(kHalf), scene.boxPose);
-      if (k == 0) startDepth = depth;
+      if (k++ == 0) startDepth = depth;
       deepest = std::max(deepest, depth);
-    }
+    });
     // Clear at the start; the tracked hand ended 1.5 cm inside, the shown one stayed on the box.
     CHECK(startDepth < 0.0f);
     CHECK(deepest <= 0.001f);
@@ -252,40 +279,23 @@ TEST_CASE("A box in the app's buffers carried down into the table it lay on stay
     scene.squeezeNow();
     REQUIRE(
         runUntil(*scene.app, [&] { return exactOnBox(scene.state(), scene.box, 1.0f, 1e-4f); }));
-    // The hand, still squeezing, goes 2 cm down into the table, 2 mm a frame, frames 11 ms apart.
-    const glm::vec3 down = openRightHand(kGrip).down;
-    std::string script = squeezeLine(0, "right", 1.0f);
-    const uint64_t firstFrame = scene.app->framesEnded + 1;
+    // The hand, still squeezing, goes 2 cm down into the table, 2 mm a frame.
     const int steps = 10;
-    for (int k = 0; k <= steps; ++k) {
-      const glm::vec3 d = down * (0.002f * float(k));
-      const XrPosef grip{kGrip.orientation,
-                         {kGrip.position.x + d.x, kGrip.position.y + d.y, kGrip.position.z + d.z}};
-      script += gripLine(firstFrame + k, "right", grip);
-    }
-    REQUIRE(scene.app->setScript(script) == XR_SUCCESS);
+    REQUIRE(scene.app->setScript(reachDown(*scene.app, steps, 0.002f, 1.0f)) == XR_SUCCESS);
     // Where the app draws the box it carries: the shown palm times palmFromTarget; its corners
     // against the table's top.
     const Pose tableFromLocal = toPose(scene.tablePose).inverse();
     const AnalyticShape table = boxShape(kTableHalf);
     float deepest = -1.0f;
     int held = 0;
-    auto next = std::chrono::steady_clock::now();
-    for (int k = 0; k <= steps + 20; ++k) {
-      next += std::chrono::microseconds(11111);
-      std::this_thread::sleep_until(next);
+    pacedFrames(*scene.app, steps + 21, [&] {
       Joints j;
+      REQUIRE(locateJoints(*scene.app, scene.tracker, j) == XR_SUCCESS);
       XrGraspHeldPoseSDFG pose{XR_TYPE_GRASP_HELD_POSE_SDFG};
       XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG, &pose};
-      XrResult located = XR_ERROR_RUNTIME_FAILURE, state = XR_ERROR_RUNTIME_FAILURE;
-      scene.app->frame([&] {
-        located = locateJoints(*scene.app, scene.tracker, j);
-        XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
-        state = scene.ext->state(scene.app->session, &gi, &st);
-      });
-      REQUIRE(located == XR_SUCCESS);
-      REQUIRE(state == XR_SUCCESS);
-      if (!pose.isValid) continue;
+      XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
+      REQUIRE(scene.ext->state(scene.app->session, &gi, &st) == XR_SUCCESS);
+      if (!pose.isValid) return;
       ++held;
       const Pose localFromBox =
           toPose(j.joints[XR_HAND_JOINT_PALM_EXT].pose) * toPose(pose.palmFromTarget);
@@ -295,10 +305,46 @@ TEST_CASE("A box in the app's buffers carried down into the table it lay on stay
         const glm::vec3 p = tableFromLocal.transformPoint(localFromBox.transformPoint(corner));
         deepest = std::max(deepest, -table.signedDistance(p));
       }
-    }
+    });
     CHECK(held > steps);  // held all along
     // The tracked hand carried it 2 cm in; the shown one keeps it on the table.
     CHECK(deepest <= 0.001f);
+  }
+  CHECK(validationLog().empty());
+  CHECK(vulkanMessages().size() == messagesBefore);
+}
+
+TEST_CASE("Two boxes in the app's buffers side by side: one is taken, neither is entered",
+          "[layer][vulkan][scenes]") {
+  if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  const size_t messagesBefore = vulkanMessages().size();
+  {
+    // 2 cm apart across the fingers, each 6 cm wide: the palm faces the gap's edge of one.
+    BufferScene scene(/*meshTable=*/false, /*withTable=*/false, kClear, -0.04f);
+    const XrPosef otherPose = awayFromPalm(belowOpenRightPalm(scene.mesh, kGrip, facingPalm(kGrip),
+                                                              openRightHand(kGrip).across * 0.04f),
+                                           kClear);
+    BufferMesh otherBuffers = uploadMesh(*scene.app, scene.mesh, 1.0f);
+    const XrGraspTargetSDFG other = scene.addBuffers(otherBuffers, otherPose);
+    scene.waitReady(2);  // both read back, one readback at a time
+    scene.squeezeNow();
+    BufferScene::State s;
+    REQUIRE(runUntil(*scene.app, [&] {
+      s = scene.state();
+      return s.state.isGrasping == XR_TRUE && s.state.target != XR_NULL_HANDLE;
+    }));
+    CHECK((s.state.target == scene.box || s.state.target == other));
+    // Every finger names one of the two boxes or nothing, and a finger on a box is exact.
+    int touching = 0;
+    for (int f = 0; f < 5; ++f) {
+      const XrGraspTargetSDFG t = s.touches.touched[f];
+      CHECK((t == XR_NULL_HANDLE || t == scene.box || t == other));
+      if (t != XR_NULL_HANDLE) ++touching;
+    }
+    CHECK(touching >= 1);
+    const Joints j = scene.joints();
+    CHECK(depthInBox(j, boxShape(kHalf), scene.boxPose) <= 0.0005f);
+    CHECK(depthInBox(j, boxShape(kHalf), otherPose) <= 0.0005f);
   }
   CHECK(validationLog().empty());
   CHECK(vulkanMessages().size() == messagesBefore);

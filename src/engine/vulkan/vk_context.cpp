@@ -211,4 +211,49 @@ const char* vkResultName(VkResult result) {
   }
 }
 
+Error vkCallError(VkResult r, const char* what) {
+  return makeError(r == VK_ERROR_OUT_OF_HOST_MEMORY || r == VK_ERROR_OUT_OF_DEVICE_MEMORY
+                       ? Status::out_of_memory
+                   : r == VK_ERROR_DEVICE_LOST ? Status::device_lost
+                                               : Status::internal,
+                   std::string("vulkan: ") + what + " failed: " + vkResultName(r));
+}
+
+Result<VkOwned<VkPipeline>> createComputePipeline(const VkContext& ctx, VkPipelineLayout layout,
+                                                  std::span<const uint32_t> code,
+                                                  uint32_t groupSize) {
+  const VkFunctions& fn = ctx.fn();
+  auto moduleInfo = vkStruct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
+  moduleInfo.codeSize = code.size_bytes();
+  moduleInfo.pCode = code.data();
+  VkShaderModule module = VK_NULL_HANDLE;
+  if (VkResult r = fn.vkCreateShaderModule(ctx.handle(), &moduleInfo, nullptr, &module))
+    return vkCallError(r, "vkCreateShaderModule");
+  const VkOwned<VkShaderModule> ownedModule(ctx, module);
+  const VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};  // constant_id 0: local_size_x
+  const VkSpecializationInfo spec{1, &entry, sizeof(uint32_t), &groupSize};
+  auto pipeInfo =
+      vkStruct<VkComputePipelineCreateInfo>(VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO);
+  pipeInfo.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+  pipeInfo.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  pipeInfo.stage.module = module;
+  pipeInfo.stage.pName = "main";
+  pipeInfo.stage.pSpecializationInfo = &spec;
+  pipeInfo.layout = layout;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  if (VkResult r = fn.vkCreateComputePipelines(ctx.handle(), VK_NULL_HANDLE, 1, &pipeInfo, nullptr,
+                                               &pipeline))
+    return vkCallError(r, "vkCreateComputePipelines");
+  return VkOwned<VkPipeline>(ctx, pipeline);
+}
+
+void recordMemoryBarrier(const VkContext& ctx, VkCommandBuffer cmd, VkPipelineStageFlags srcStage,
+                         VkAccessFlags srcAccess, VkPipelineStageFlags dstStage,
+                         VkAccessFlags dstAccess) {
+  auto mb = vkStruct<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
+  mb.srcAccessMask = srcAccess;
+  mb.dstAccessMask = dstAccess;
+  ctx.fn().vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 1, &mb, 0, nullptr, 0, nullptr);
+}
+
 }  // namespace sdfg

@@ -11,6 +11,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <utility>
 
 #include <vulkan/vulkan_core.h>
@@ -203,6 +204,22 @@ VkResult flushBuffer(const VkContext& ctx, const VkBufferAlloc& b);
 VkResult invalidateBuffer(const VkContext& ctx, const VkBufferAlloc& b);
 
 const char* vkResultName(VkResult result);
+
+// The error a failed call `what` returned: out_of_memory, device_lost or internal, with a
+// message that names the call and the VkResult.
+Error vkCallError(VkResult result, const char* what);
+
+// A compute pipeline of `code` (SPIR-V, entry point main) on `layout`, whose local_size_x is
+// specialization constant 0, set to `groupSize`. The shader module lives only until the
+// pipeline exists. Errors: vkCallError of the failing call.
+Result<VkOwned<VkPipeline>> createComputePipeline(const VkContext& ctx, VkPipelineLayout layout,
+                                                  std::span<const uint32_t> code,
+                                                  uint32_t groupSize);
+
+// Records one global memory barrier into `cmd`.
+void recordMemoryBarrier(const VkContext& ctx, VkCommandBuffer cmd, VkPipelineStageFlags srcStage,
+                         VkAccessFlags srcAccess, VkPipelineStageFlags dstStage,
+                         VkAccessFlags dstAccess);
 
 // A zeroed Vulkan info struct with its sType set.
 template <class T>

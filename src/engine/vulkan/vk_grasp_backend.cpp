@@ -325,16 +325,8 @@ void VkGraspBackend::cancel(size_t slot) {
 
 Status VkGraspBackend::setDeviceMesh(uint64_t id, const VkMeshBuffers& buffers) {
   if (failed_) return Status::device_lost;
-  const VkDeviceSize indexSize = buffers.indexType == VK_INDEX_TYPE_UINT16 ? 2 : 4;
   // The builder's checks, made here too so that a bad description fails at registration.
-  if (buffers.positions == VK_NULL_HANDLE || buffers.indices == VK_NULL_HANDLE ||
-      buffers.vertexCount == 0 || buffers.indexCount < 3 || buffers.indexCount % 3 != 0 ||
-      buffers.positionStride < 12 || buffers.positionStride % 4 != 0 ||
-      buffers.positionOffset % 4 != 0 || buffers.indexOffset % indexSize != 0 ||
-      (buffers.indexType != VK_INDEX_TYPE_UINT16 && buffers.indexType != VK_INDEX_TYPE_UINT32) ||
-      buffers.indexCount / 3 > (1u << 30) || buffers.positionOffset / 4 > UINT32_MAX ||
-      buffers.indexOffset / indexSize > UINT32_MAX)
-    return Status::invalid_argument;
+  if (!validMeshBuffers(buffers)) return Status::invalid_argument;
   if (ownQueue_ && !options_.prepareInBackground) {
     // App buffers are read on the app's queue (see the header): builders there, made once (by
     // the preparation thread when there is one).

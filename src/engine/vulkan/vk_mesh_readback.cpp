@@ -18,14 +18,6 @@ struct PushConstants {
   uint32_t positionOffset, positionStride, vertexCount, indexOffset, indexCount, index16;
 };
 
-Error vkError(VkResult r, const char* what) {
-  return makeError(r == VK_ERROR_OUT_OF_HOST_MEMORY || r == VK_ERROR_OUT_OF_DEVICE_MEMORY
-                       ? Status::out_of_memory
-                   : r == VK_ERROR_DEVICE_LOST ? Status::device_lost
-                                               : Status::internal,
-                   std::string("vulkan: ") + what + " failed: " + vkResultName(r));
-}
-
 }  // namespace
 
 struct VkMeshReadback::Objects {
@@ -71,7 +63,7 @@ Result<std::unique_ptr<VkMeshReadback>> VkMeshReadback::create(
   setInfo.pBindings = bindings.data();
   VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
   if (VkResult r = fn.vkCreateDescriptorSetLayout(dev, &setInfo, nullptr, &setLayout))
-    return vkError(r, "vkCreateDescriptorSetLayout");
+    return vkCallError(r, "vkCreateDescriptorSetLayout");
   o.setLayout = VkOwned<VkDescriptorSetLayout>(c, setLayout);
 
   VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(PushConstants)};
@@ -83,31 +75,12 @@ Result<std::unique_ptr<VkMeshReadback>> VkMeshReadback::create(
   layoutInfo.pPushConstantRanges = &push;
   VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
   if (VkResult r = fn.vkCreatePipelineLayout(dev, &layoutInfo, nullptr, &pipelineLayout))
-    return vkError(r, "vkCreatePipelineLayout");
+    return vkCallError(r, "vkCreatePipelineLayout");
   o.pipelineLayout = VkOwned<VkPipelineLayout>(c, pipelineLayout);
 
-  auto moduleInfo = vkStruct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
-  moduleInfo.codeSize = sizeof(spirv::k_mesh_gather);
-  moduleInfo.pCode = spirv::k_mesh_gather;
-  VkShaderModule module = VK_NULL_HANDLE;
-  if (VkResult r = fn.vkCreateShaderModule(dev, &moduleInfo, nullptr, &module))
-    return vkError(r, "vkCreateShaderModule");
-  VkOwned<VkShaderModule> ownedModule(c, module);  // only needed until the pipeline exists
-  const VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};  // constant_id 0: local_size_x
-  const VkSpecializationInfo spec{1, &entry, sizeof(uint32_t), &b->groupSize_};
-  auto pipeInfo =
-      vkStruct<VkComputePipelineCreateInfo>(VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO);
-  pipeInfo.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-  pipeInfo.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-  pipeInfo.stage.module = module;
-  pipeInfo.stage.pName = "main";
-  pipeInfo.stage.pSpecializationInfo = &spec;
-  pipeInfo.layout = pipelineLayout;
-  VkPipeline pipeline = VK_NULL_HANDLE;
-  if (VkResult r =
-          fn.vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &pipeInfo, nullptr, &pipeline))
-    return vkError(r, "vkCreateComputePipelines");
-  o.pipeline = VkOwned<VkPipeline>(c, pipeline);
+  auto pipeline = createComputePipeline(c, pipelineLayout, spirv::k_mesh_gather, b->groupSize_);
+  if (!pipeline) return pipeline.error();
+  o.pipeline = std::move(pipeline.value());
 
   const VkDescriptorPoolSize poolSize{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3};
   auto poolInfo =
@@ -117,7 +90,7 @@ Result<std::unique_ptr<VkMeshReadback>> VkMeshReadback::create(
   poolInfo.pPoolSizes = &poolSize;
   VkDescriptorPool pool = VK_NULL_HANDLE;
   if (VkResult r = fn.vkCreateDescriptorPool(dev, &poolInfo, nullptr, &pool))
-    return vkError(r, "vkCreateDescriptorPool");
+    return vkCallError(r, "vkCreateDescriptorPool");
   o.descriptorPool = VkOwned<VkDescriptorPool>(c, pool);
   auto setAlloc =
       vkStruct<VkDescriptorSetAllocateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO);
@@ -125,14 +98,14 @@ Result<std::unique_ptr<VkMeshReadback>> VkMeshReadback::create(
   setAlloc.descriptorSetCount = 1;
   setAlloc.pSetLayouts = &setLayout;
   if (VkResult r = fn.vkAllocateDescriptorSets(dev, &setAlloc, &o.set))
-    return vkError(r, "vkAllocateDescriptorSets");
+    return vkCallError(r, "vkAllocateDescriptorSets");
 
   auto cmdPoolInfo = vkStruct<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
   cmdPoolInfo.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
   cmdPoolInfo.queueFamilyIndex = device.queueFamilyIndex;
   VkCommandPool cmdPool = VK_NULL_HANDLE;
   if (VkResult r = fn.vkCreateCommandPool(dev, &cmdPoolInfo, nullptr, &cmdPool))
-    return vkError(r, "vkCreateCommandPool");
+    return vkCallError(r, "vkCreateCommandPool");
   o.commandPool = VkOwned<VkCommandPool>(c, cmdPool);
   auto cmdAlloc =
       vkStruct<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
@@ -140,12 +113,12 @@ Result<std::unique_ptr<VkMeshReadback>> VkMeshReadback::create(
   cmdAlloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   cmdAlloc.commandBufferCount = 1;
   if (VkResult r = fn.vkAllocateCommandBuffers(dev, &cmdAlloc, &o.cmd))
-    return vkError(r, "vkAllocateCommandBuffers");
+    return vkCallError(r, "vkAllocateCommandBuffers");
 
   auto fenceInfo = vkStruct<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
   VkFence fence = VK_NULL_HANDLE;
   if (VkResult r = fn.vkCreateFence(dev, &fenceInfo, nullptr, &fence))
-    return vkError(r, "vkCreateFence");
+    return vkCallError(r, "vkCreateFence");
   o.fence = VkOwned<VkFence>(c, fence);
   return b;
 }
@@ -165,7 +138,7 @@ VkMeshReadback::~VkMeshReadback() {
 }
 
 Status VkMeshReadback::fail(VkResult result, const char* what) {
-  const Error e = vkError(result, what);
+  const Error e = vkCallError(result, what);
   if (!failed_) {
     const std::string line = "sdfg: mesh readback disabled: " + e.message;
     if (log_)
@@ -181,14 +154,8 @@ Status VkMeshReadback::submit(uint64_t id, uint64_t generation, const VkMeshBuff
                               bool withIndices) {
   if (failed_) return Status::device_lost;
   if (pending_) return Status::unsupported;
+  if (!validMeshBuffers(buffers)) return Status::invalid_argument;
   const uint32_t indexSize = buffers.indexType == VK_INDEX_TYPE_UINT16 ? 2 : 4;
-  if (buffers.positions == VK_NULL_HANDLE || buffers.indices == VK_NULL_HANDLE ||
-      buffers.vertexCount == 0 || buffers.indexCount < 3 || buffers.indexCount % 3 != 0 ||
-      buffers.positionStride < 12 || buffers.positionStride % 4 != 0 ||
-      buffers.positionOffset % 4 != 0 || buffers.indexOffset % indexSize != 0 ||
-      (buffers.indexType != VK_INDEX_TYPE_UINT16 && buffers.indexType != VK_INDEX_TYPE_UINT32) ||
-      buffers.positionOffset / 4 > UINT32_MAX || buffers.indexOffset / indexSize > UINT32_MAX)
-    return Status::invalid_argument;
   if (simulateLost_) return fail(VK_ERROR_DEVICE_LOST, "vkQueueSubmit (simulated)");
   const VkContext& c = *ctx_;
   const VkFunctions& fn = c.fn();
@@ -226,17 +193,10 @@ Status VkMeshReadback::submit(uint64_t id, uint64_t generation, const VkMeshBuff
   auto begin = vkStruct<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   if (VkResult r = fn.vkBeginCommandBuffer(cmd, &begin)) return fail(r, "vkBeginCommandBuffer");
-  auto barrier = [&](VkPipelineStageFlags srcStage, VkAccessFlags srcAccess,
-                     VkPipelineStageFlags dstStage, VkAccessFlags dstAccess) {
-    auto mb = vkStruct<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
-    mb.srcAccessMask = srcAccess;
-    mb.dstAccessMask = dstAccess;
-    fn.vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 1, &mb, 0, nullptr, 0, nullptr);
-  };
   // The app's skinning (a shader or a copy earlier on this queue) is visible to the gather.
-  barrier(VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
-          VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
-          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+  recordMemoryBarrier(c, cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
+                      VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
   fn.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, o.pipeline.get());
   fn.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, o.pipelineLayout.get(), 0, 1,
                              &o.set, 0, nullptr);
@@ -250,8 +210,8 @@ Status VkMeshReadback::submit(uint64_t id, uint64_t generation, const VkMeshBuff
                         &pc);
   const uint64_t items = std::max(buffers.vertexCount, indexCount);
   fn.vkCmdDispatch(cmd, uint32_t((items + groupSize_ - 1) / groupSize_), 1, 1);
-  barrier(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-          VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+  recordMemoryBarrier(c, cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
   if (VkResult r = fn.vkEndCommandBuffer(cmd)) return fail(r, "vkEndCommandBuffer");
 
   const VkFence fence = o.fence.get();

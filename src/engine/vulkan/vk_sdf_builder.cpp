@@ -32,13 +32,7 @@ Result<std::unique_ptr<VkSdfBuilder>> VkSdfBuilder::create(const VulkanDevice& d
   const VkFunctions& fn = c.fn();
   Objects& o = *b->objects_;
   const VkDevice dev = c.handle();
-  auto error = [](VkResult r, const char* what) {
-    return makeError(r == VK_ERROR_OUT_OF_HOST_MEMORY || r == VK_ERROR_OUT_OF_DEVICE_MEMORY
-                         ? Status::out_of_memory
-                     : r == VK_ERROR_DEVICE_LOST ? Status::device_lost
-                                                 : Status::internal,
-                     std::string("vulkan: ") + what + " failed: " + vkResultName(r));
-  };
+  auto error = vkCallError;
 
   const VkPhysicalDeviceLimits& limits = c.properties().limits;
   b->workGroupSize_ = std::clamp<uint32_t>(
@@ -83,34 +77,11 @@ Result<std::unique_ptr<VkSdfBuilder>> VkSdfBuilder::create(const VulkanDevice& d
   // device has); a device with smaller groups floods step by step at every grid size.
   const bool groupFlood = limits.maxComputeWorkGroupSize[0] >= L::kFloodGroupThreads &&
                           limits.maxComputeWorkGroupInvocations >= L::kFloodGroupThreads;
-  const VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};  // constant_id 0: local_size_x
-  const uint32_t groupSize = b->workGroupSize_;
-  const VkSpecializationInfo spec{1, &entry, sizeof(uint32_t), &groupSize};
   for (uint32_t p = 0; p < kPassCount; ++p) {
     if (p == kFloodGroup && !groupFlood) continue;
-    auto moduleInfo =
-        vkStruct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
-    moduleInfo.codeSize = code[p].size_bytes();
-    moduleInfo.pCode = code[p].data();
-    VkShaderModule module = VK_NULL_HANDLE;
-    if (VkResult r = fn.vkCreateShaderModule(dev, &moduleInfo, nullptr, &module)) {
-      return error(r, "vkCreateShaderModule");
-    }
-    VkOwned<VkShaderModule> ownedModule(c, module);  // only needed until the pipeline exists
-    auto pipeInfo =
-        vkStruct<VkComputePipelineCreateInfo>(VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO);
-    pipeInfo.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-    pipeInfo.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    pipeInfo.stage.module = module;
-    pipeInfo.stage.pName = "main";
-    pipeInfo.stage.pSpecializationInfo = &spec;
-    pipeInfo.layout = pipelineLayout;
-    VkPipeline pipeline = VK_NULL_HANDLE;
-    if (VkResult r =
-            fn.vkCreateComputePipelines(dev, VK_NULL_HANDLE, 1, &pipeInfo, nullptr, &pipeline)) {
-      return error(r, "vkCreateComputePipelines");
-    }
-    o.pipelines[p] = VkOwned<VkPipeline>(c, pipeline);
+    auto pipeline = createComputePipeline(c, pipelineLayout, code[p], b->workGroupSize_);
+    if (!pipeline) return pipeline.error();
+    o.pipelines[p] = std::move(pipeline.value());
   }
 
   const std::array<VkDescriptorPoolSize, 1> poolSizes = {
@@ -359,17 +330,19 @@ Status VkSdfBuilder::setMesh(const TriangleMesh& mesh) {
   return Status::ok;
 }
 
+bool validMeshBuffers(const VkMeshBuffers& m) {
+  const VkDeviceSize indexSize = m.indexType == VK_INDEX_TYPE_UINT16 ? 2 : 4;
+  return m.positions != VK_NULL_HANDLE && m.indices != VK_NULL_HANDLE && m.vertexCount != 0 &&
+         m.indexCount >= 3 && m.indexCount % 3 == 0 && m.positionStride >= 12 &&
+         m.positionStride % 4 == 0 && m.positionOffset % 4 == 0 && m.indexOffset % indexSize == 0 &&
+         (m.indexType == VK_INDEX_TYPE_UINT16 || m.indexType == VK_INDEX_TYPE_UINT32) &&
+         m.indexCount / 3 <= (1u << 30) && m.positionOffset / 4 <= UINT32_MAX &&
+         m.indexOffset / indexSize <= UINT32_MAX;
+}
+
 Status VkSdfBuilder::setMesh(const VkMeshBuffers& m) {
   if (Status s = checkUsable(); s != Status::ok) return s;
-  const VkDeviceSize indexSize = m.indexType == VK_INDEX_TYPE_UINT16 ? 2 : 4;
-  if (m.positions == VK_NULL_HANDLE || m.indices == VK_NULL_HANDLE || m.vertexCount == 0 ||
-      m.indexCount < 3 || m.indexCount % 3 != 0 || m.positionStride < 12 ||
-      m.positionStride % 4 != 0 || m.positionOffset % 4 != 0 || m.indexOffset % indexSize != 0 ||
-      (m.indexType != VK_INDEX_TYPE_UINT16 && m.indexType != VK_INDEX_TYPE_UINT32) ||
-      m.indexCount / 3 > (1u << 30) || m.positionOffset / 4 > UINT32_MAX ||
-      m.indexOffset / indexSize > UINT32_MAX) {
-    return Status::invalid_argument;
-  }
+  if (!validMeshBuffers(m)) return Status::invalid_argument;
   appMesh_ = m;
   meshSource_ = MeshSource::app;
   pseudoNormalSign_ = false;

@@ -56,6 +56,11 @@ struct VkMeshBuffers {
   uint32_t indexCount = 0;                       // multiple of 3, at least 3
 };
 
+// Whether `m` is a description the builder and the readback take: both buffers, counts,
+// alignments and index type as VkMeshBuffers says (the values in the buffers are checked where
+// they are read).
+bool validMeshBuffers(const VkMeshBuffers& m);
+
 struct VkSdfOptions {
   uint32_t workGroupSize = 64;  // clamped to the device limits
   // A hierarchy cluster farther than beta times its radius uses its dipole term. 2 keeps the

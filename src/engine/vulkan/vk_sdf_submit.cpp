@@ -119,10 +119,7 @@ Status VkSdfBuilder::record(bool build, size_t pointCount, bool readBack) {
 
   auto barrier = [&](VkPipelineStageFlags srcStage, VkAccessFlags srcAccess,
                      VkPipelineStageFlags dstStage, VkAccessFlags dstAccess) {
-    auto mb = vkStruct<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
-    mb.srcAccessMask = srcAccess;
-    mb.dstAccessMask = dstAccess;
-    fn.vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 1, &mb, 0, nullptr, 0, nullptr);
+    recordMemoryBarrier(*ctx_, cmd, srcStage, srcAccess, dstStage, dstAccess);
   };
   constexpr VkPipelineStageFlags kCompute = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
   constexpr VkPipelineStageFlags kTransfer = VK_PIPELINE_STAGE_TRANSFER_BIT;

@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "io/shapes.h"
@@ -34,6 +35,7 @@ class FakeDevice final : public DeferredSdfBackend {
     std::atomic<bool> inReady{false};
     std::atomic<bool> failNext{false};
     std::atomic<bool> throwInReady{false};  // the next ready() throws
+    std::atomic<bool> readbacks{false};     // requestReadback answers (else: unsupported)
     std::vector<glm::vec3> lastMesh;        // the positions of the last request with a mesh
     std::vector<std::thread::id> callers;   // written by the pumping thread only
     std::vector<std::string> order;
@@ -98,6 +100,13 @@ class FakeDevice final : public DeferredSdfBackend {
     log_->inReady = false;
     return true;
   }
+  Status requestReadback(uint64_t id, uint64_t generation) override {
+    note("readback");
+    if (!log_->readbacks) return Status::unsupported;
+    readbacks_.push_back(MeshReadback{id, generation, {glm::vec3(1.0f)}, {}});
+    return Status::ok;
+  }
+  std::vector<MeshReadback> takeReadbacks() override { return std::exchange(readbacks_, {}); }
   void finish(size_t slot) { slots_[slot].done = true; }
 
  private:
@@ -112,6 +121,7 @@ class FakeDevice final : public DeferredSdfBackend {
   }
   std::shared_ptr<Log> log_;
   std::array<Slot, kSlots> slots_;
+  std::vector<MeshReadback> readbacks_;
   bool failed_ = false;
 };
 
@@ -415,4 +425,33 @@ TEST_CASE("A shared mesh is recorded without a copy and handed to the device at 
   CHECK(mesh.indices.use_count() == 1);
   CHECK(f.owner->requestShared(1, 7, 1, SharedMesh{}, Pose{}, GridBox::referenceDefault()) ==
         Status::invalid_argument);
+}
+
+TEST_CASE(
+    "Readbacks go through the pump; one the device refuses comes back empty, then none is taken",
+    "[core][deferred_mailbox]") {
+  Fixture f;
+  CHECK(f.owner->requestReadback(5, 1) == Status::invalid_argument);  // no such device mesh
+  f.mailbox->noteDeviceMesh(5, true);
+  f.log->readbacks = true;
+  REQUIRE(f.owner->requestReadback(5, 1) == Status::ok);
+  REQUIRE(f.owner->requestReadback(5, 2) == Status::ok);  // the newer replaces the older
+  CHECK(f.owner->needsSubmit(true));
+  CHECK(f.owner->takeReadbacks().empty());  // nothing before a pump
+  REQUIRE(f.mailbox->pump(true));
+  std::vector<MeshReadback> got = f.owner->takeReadbacks();
+  REQUIRE(got.size() == 1);
+  CHECK(got[0].id == 5);
+  CHECK(got[0].generation == 2);
+  CHECK(got[0].positions.size() == 1);
+  // A device that cannot read meshes back: the request comes back empty (the owner must not wait
+  // for it), and later ones are refused at once.
+  f.log->readbacks = false;
+  REQUIRE(f.owner->requestReadback(5, 3) == Status::ok);
+  REQUIRE(f.mailbox->pump(true));
+  got = f.owner->takeReadbacks();
+  REQUIRE(got.size() == 1);
+  CHECK(got[0].generation == 3);
+  CHECK(got[0].positions.empty());
+  CHECK(f.owner->requestReadback(5, 4) == Status::unsupported);
 }

@@ -42,6 +42,15 @@ bool GraspSession::nearHand(uint64_t id, const Target& t) const {
 }
 
 void GraspSession::collectReadbacks() {
+  if (!deferredUsable() && mirrorsPending_ > 0) {
+    // The device failed or went: readbacks asked will never come. Those targets go on as before
+    // readbacks (a device target is lost with its device anyway).
+    for (auto& [id, t] : targets_) {
+      if (t.mirror != Mirror::asked) continue;
+      t.mirror = Mirror::none;
+      --mirrorsPending_;
+    }
+  }
   if (deferred_ == nullptr) return;
   // Changes made while far from every hand, now that a hand is near.
   if (!staleTargets_.empty()) {
@@ -60,6 +69,14 @@ void GraspSession::collectReadbacks() {
     auto it = targets_.find(r.id);
     if (it == targets_.end() || !it->second.deviceTarget) continue;  // removed meanwhile
     Target& t = it->second;
+    if (r.positions.empty()) {
+      // Refused by the device: a target still waiting for its first copy goes on without one.
+      if (t.mirror == Mirror::asked) {
+        t.mirror = Mirror::none;
+        --mirrorsPending_;
+      }
+      continue;
+    }
     if (r.generation <= t.readbackApplied || t.mirror == Mirror::failed) continue;
     t.readbackApplied = r.generation;
     ++t.version;

@@ -292,6 +292,8 @@ bool DeferredMailbox::pump(bool sharedQueueFree) {
     for (auto it = readbackRequests.begin(); it != readbackRequests.end();) {
       const Status st = device.requestReadback(it->first, it->second);
       readbackUnsupported = readbackUnsupported || st == Status::unsupported;
+      // The owner hears of a refusal as an empty readback (it would wait for it otherwise).
+      if (st != Status::ok) readbacks.push_back(MeshReadback{it->first, it->second, {}, {}});
       it = readbackRequests.erase(it);
     }
     for (size_t i = 0; i < kSlots; ++i) {
@@ -310,7 +312,7 @@ bool DeferredMailbox::pump(bool sharedQueueFree) {
       v.poll = device.poll(i, v.grid);
       v.polled = true;
     }
-    readbacks = device.takeReadbacks();
+    for (MeshReadback& r : device.takeReadbacks()) readbacks.push_back(std::move(r));
     needsSubmit = device.needsSubmit(true);
     finished = true;
   } catch (...) {

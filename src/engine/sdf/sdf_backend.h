@@ -57,6 +57,8 @@ struct SharedMesh {
 // position the device's buffer does not hold reads as NaN) and, when they were read too, the
 // indices (an index the buffer does not hold reads as UINT32_MAX). The CPU's mesh checks refuse
 // both, so a bad description ends as a refused set-up, never as a read out of bounds.
+// No positions at all: the request was refused after it was taken (the device cannot read
+// meshes back, or no longer has the mesh).
 struct MeshReadback {
   uint64_t id = 0;
   uint64_t generation = 0;  // the requester's, echoed

@@ -243,7 +243,9 @@ std::optional<MeshReadback> VkMeshReadback::collect() {
   mesh.indices.resize(indexCount_);
   const auto* words = static_cast<const char*>(out.mapped);
   std::memcpy(mesh.positions.data(), words, size_t(vertexCount_) * 12);
-  std::memcpy(mesh.indices.data(), words + size_t(vertexCount_) * 12, size_t(indexCount_) * 4);
+  // Positions only: no indices to copy (and memcpy must not see the empty vector's null data).
+  if (indexCount_ > 0)
+    std::memcpy(mesh.indices.data(), words + size_t(vertexCount_) * 12, size_t(indexCount_) * 4);
   return mesh;
 }
 

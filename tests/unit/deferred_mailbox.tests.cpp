@@ -427,9 +427,8 @@ TEST_CASE("A shared mesh is recorded without a copy and handed to the device at 
         Status::invalid_argument);
 }
 
-TEST_CASE(
-    "Readbacks go through the pump; one the device refuses comes back empty, then none is taken",
-    "[core][deferred_mailbox]") {
+TEST_CASE("Readbacks go through the pump, and one the device refuses comes back empty",
+          "[core][deferred_mailbox]") {
   Fixture f;
   CHECK(f.owner->requestReadback(5, 1) == Status::invalid_argument);  // no such device mesh
   f.mailbox->noteDeviceMesh(5, true);

@@ -185,6 +185,22 @@ void pacedFrames(App& app, int frames, F inFrame) {
   }
 }
 
+// Runs `body` with the Vulkan validation layer watching: no message from it, nor from the
+// OpenXR core validation layer, while the scene lived.
+template <class F>
+void validated(F body) {
+  const size_t messagesBefore = vulkanMessages().size();
+  body();
+  CHECK(validationLog().empty());
+  CHECK(vulkanMessages().size() == messagesBefore);
+}
+
+// Squeezes and waits until the box is held with exact contacts on it.
+void graspBox(const BufferScene& scene) {
+  scene.squeezeNow();
+  REQUIRE(runUntil(*scene.app, [&] { return exactOnBox(scene.state(), scene.box, 1.0f, 1e-4f); }));
+}
+
 }  // namespace
 
 TEST_CASE("A box in the app's buffers lying on a table is taken and stopped on as a CPU mesh is",
@@ -192,12 +208,9 @@ TEST_CASE("A box in the app's buffers lying on a table is taken and stopped on a
   if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
   const bool meshTable = GENERATE(false, true);
   CAPTURE(meshTable);
-  const size_t messagesBefore = vulkanMessages().size();
-  {
+  validated([&] {
     BufferScene scene(meshTable, true, kClear);
-    scene.squeezeNow();
-    REQUIRE(
-        runUntil(*scene.app, [&] { return exactOnBox(scene.state(), scene.box, 1.0f, 1e-4f); }));
+    graspBox(scene);
     const BufferScene::State s = scene.state();
     // Taken, and named by the fingers on it (each finger names what it touches).
     CHECK(s.state.target == scene.box);
@@ -210,20 +223,15 @@ TEST_CASE("A box in the app's buffers lying on a table is taken and stopped on a
     const Joints j = scene.joints();
     CHECK(depthInBox(j, boxShape(kTableHalf), scene.tablePose) <= 0.001f);
     CHECK(depthInBox(j, boxShape(kHalf), scene.boxPose) <= 0.0005f);
-  }
-  CHECK(validationLog().empty());
-  CHECK(vulkanMessages().size() == messagesBefore);
+  });
 }
 
 TEST_CASE("A box in the app's buffers held on a table follows what the app writes into them",
           "[layer][vulkan][scenes]") {
   if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
-  const size_t messagesBefore = vulkanMessages().size();
-  {
+  validated([&] {
     BufferScene scene(/*meshTable=*/false, true, kClear);
-    scene.squeezeNow();
-    REQUIRE(
-        runUntil(*scene.app, [&] { return exactOnBox(scene.state(), scene.box, 1.0f, 1e-4f); }));
+    graspBox(scene);
     auto update =
         scene.app->fn<PFN_xrUpdateGraspTargetVerticesSDFG>("xrUpdateGraspTargetVerticesSDFG");
     // The box grows about its centre in two steps (a skinned mesh's new poses), into the hand. Each
@@ -239,16 +247,13 @@ TEST_CASE("A box in the app's buffers held on a table follows what the app write
       CHECK(depthInBox(j, boxShape(kHalf, scale), scene.boxPose) <= 0.0005f);
       CHECK(depthInBox(j, boxShape(kTableHalf), scene.tablePose) <= 0.001f);
     }
-  }
-  CHECK(validationLog().empty());
-  CHECK(vulkanMessages().size() == messagesBefore);
+  });
 }
 
 TEST_CASE("The outer hand keeps an open hand out of a box in the app's buffers it reaches into",
           "[layer][vulkan][outer_hand]") {
   if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
-  const size_t messagesBefore = vulkanMessages().size();
-  {
+  validated([&] {
     BufferScene scene(/*meshTable=*/false, /*withTable=*/false, /*lower=*/kClear + 0.004f);
     // Down from 7 mm clear of the box to 1.5 cm into it, 2 mm a frame, then still; squeeze 0.
     const int steps = 11;
@@ -265,20 +270,15 @@ TEST_CASE("The outer hand keeps an open hand out of a box in the app's buffers i
     // Clear at the start; the tracked hand ended 1.5 cm inside, the shown one stayed on the box.
     CHECK(startDepth < 0.0f);
     CHECK(deepest <= 0.001f);
-  }
-  CHECK(validationLog().empty());
-  CHECK(vulkanMessages().size() == messagesBefore);
+  });
 }
 
 TEST_CASE("A box in the app's buffers carried down into the table it lay on stays on the table",
           "[layer][vulkan][outer_hand]") {
   if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
-  const size_t messagesBefore = vulkanMessages().size();
-  {
+  validated([&] {
     BufferScene scene(/*meshTable=*/false, true, kClear);
-    scene.squeezeNow();
-    REQUIRE(
-        runUntil(*scene.app, [&] { return exactOnBox(scene.state(), scene.box, 1.0f, 1e-4f); }));
+    graspBox(scene);
     // The hand, still squeezing, goes 2 cm down into the table, 2 mm a frame.
     const int steps = 10;
     REQUIRE(scene.app->setScript(reachDown(*scene.app, steps, 0.002f, 1.0f)) == XR_SUCCESS);
@@ -309,16 +309,13 @@ TEST_CASE("A box in the app's buffers carried down into the table it lay on stay
     CHECK(held > steps);  // held all along
     // The tracked hand carried it 2 cm in; the shown one keeps it on the table.
     CHECK(deepest <= 0.001f);
-  }
-  CHECK(validationLog().empty());
-  CHECK(vulkanMessages().size() == messagesBefore);
+  });
 }
 
 TEST_CASE("Two boxes in the app's buffers side by side: one is taken, neither is entered",
           "[layer][vulkan][scenes]") {
   if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
-  const size_t messagesBefore = vulkanMessages().size();
-  {
+  validated([&] {
     // 2 cm apart across the fingers, each 6 cm wide: the palm faces the gap's edge of one.
     BufferScene scene(/*meshTable=*/false, /*withTable=*/false, kClear, -0.04f);
     const XrPosef otherPose = awayFromPalm(belowOpenRightPalm(scene.mesh, kGrip, facingPalm(kGrip),
@@ -345,7 +342,5 @@ TEST_CASE("Two boxes in the app's buffers side by side: one is taken, neither is
     const Joints j = scene.joints();
     CHECK(depthInBox(j, boxShape(kHalf), scene.boxPose) <= 0.0005f);
     CHECK(depthInBox(j, boxShape(kHalf), otherPose) <= 0.0005f);
-  }
-  CHECK(validationLog().empty());
-  CHECK(vulkanMessages().size() == messagesBefore);
+  });
 }

@@ -247,6 +247,40 @@ Result<VkOwned<VkPipeline>> createComputePipeline(const VkContext& ctx, VkPipeli
   return VkOwned<VkPipeline>(ctx, pipeline);
 }
 
+std::optional<Error> createComputeLayouts(const VkContext& ctx, uint32_t bindings,
+                                          uint32_t pushBytes,
+                                          VkOwned<VkDescriptorSetLayout>& setLayout,
+                                          VkOwned<VkPipelineLayout>& pipelineLayout) {
+  const VkFunctions& fn = ctx.fn();
+  std::vector<VkDescriptorSetLayoutBinding> list(bindings);
+  for (uint32_t i = 0; i < bindings; ++i) {
+    list[i].binding = i;
+    list[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    list[i].descriptorCount = 1;
+    list[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+  }
+  auto setInfo = vkStruct<VkDescriptorSetLayoutCreateInfo>(
+      VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
+  setInfo.bindingCount = bindings;
+  setInfo.pBindings = list.data();
+  VkDescriptorSetLayout set = VK_NULL_HANDLE;
+  if (VkResult r = fn.vkCreateDescriptorSetLayout(ctx.handle(), &setInfo, nullptr, &set))
+    return vkCallError(r, "vkCreateDescriptorSetLayout");
+  setLayout = VkOwned<VkDescriptorSetLayout>(ctx, set);
+  const VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, pushBytes};
+  auto layoutInfo =
+      vkStruct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
+  layoutInfo.setLayoutCount = 1;
+  layoutInfo.pSetLayouts = &set;
+  layoutInfo.pushConstantRangeCount = 1;
+  layoutInfo.pPushConstantRanges = &push;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  if (VkResult r = fn.vkCreatePipelineLayout(ctx.handle(), &layoutInfo, nullptr, &layout))
+    return vkCallError(r, "vkCreatePipelineLayout");
+  pipelineLayout = VkOwned<VkPipelineLayout>(ctx, layout);
+  return std::nullopt;
+}
+
 void recordMemoryBarrier(const VkContext& ctx, VkCommandBuffer cmd, VkPipelineStageFlags srcStage,
                          VkAccessFlags srcAccess, VkPipelineStageFlags dstStage,
                          VkAccessFlags dstAccess) {

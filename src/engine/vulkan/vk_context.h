@@ -11,6 +11,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <utility>
 
@@ -215,6 +216,13 @@ Error vkCallError(VkResult result, const char* what);
 Result<VkOwned<VkPipeline>> createComputePipeline(const VkContext& ctx, VkPipelineLayout layout,
                                                   std::span<const uint32_t> code,
                                                   uint32_t groupSize);
+
+// The layouts of a compute pass: one descriptor set of `bindings` storage buffers (bindings 0..
+// bindings - 1) and `pushBytes` of push constants. Errors: vkCallError of the failing call.
+std::optional<Error> createComputeLayouts(const VkContext& ctx, uint32_t bindings,
+                                          uint32_t pushBytes,
+                                          VkOwned<VkDescriptorSetLayout>& setLayout,
+                                          VkOwned<VkPipelineLayout>& pipelineLayout);
 
 // Records one global memory barrier into `cmd`.
 void recordMemoryBarrier(const VkContext& ctx, VkCommandBuffer cmd, VkPipelineStageFlags srcStage,

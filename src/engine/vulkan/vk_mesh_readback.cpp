@@ -50,33 +50,10 @@ Result<std::unique_ptr<VkMeshReadback>> VkMeshReadback::create(
   b->groupSize_ =
       std::min({64u, limits.maxComputeWorkGroupSize[0], limits.maxComputeWorkGroupInvocations});
 
-  std::array<VkDescriptorSetLayoutBinding, 3> bindings{};
-  for (uint32_t i = 0; i < bindings.size(); ++i) {
-    bindings[i].binding = i;
-    bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    bindings[i].descriptorCount = 1;
-    bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-  }
-  auto setInfo = vkStruct<VkDescriptorSetLayoutCreateInfo>(
-      VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
-  setInfo.bindingCount = uint32_t(bindings.size());
-  setInfo.pBindings = bindings.data();
-  VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
-  if (VkResult r = fn.vkCreateDescriptorSetLayout(dev, &setInfo, nullptr, &setLayout))
-    return vkCallError(r, "vkCreateDescriptorSetLayout");
-  o.setLayout = VkOwned<VkDescriptorSetLayout>(c, setLayout);
-
-  VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(PushConstants)};
-  auto layoutInfo =
-      vkStruct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
-  layoutInfo.setLayoutCount = 1;
-  layoutInfo.pSetLayouts = &setLayout;
-  layoutInfo.pushConstantRangeCount = 1;
-  layoutInfo.pPushConstantRanges = &push;
-  VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
-  if (VkResult r = fn.vkCreatePipelineLayout(dev, &layoutInfo, nullptr, &pipelineLayout))
-    return vkCallError(r, "vkCreatePipelineLayout");
-  o.pipelineLayout = VkOwned<VkPipelineLayout>(c, pipelineLayout);
+  if (auto e = createComputeLayouts(c, 3, sizeof(PushConstants), o.setLayout, o.pipelineLayout))
+    return *e;
+  const VkDescriptorSetLayout setLayout = o.setLayout.get();
+  const VkPipelineLayout pipelineLayout = o.pipelineLayout.get();
 
   auto pipeline = createComputePipeline(c, pipelineLayout, spirv::k_mesh_gather, b->groupSize_);
   if (!pipeline) return pipeline.error();

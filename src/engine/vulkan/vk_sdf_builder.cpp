@@ -39,35 +39,11 @@ Result<std::unique_ptr<VkSdfBuilder>> VkSdfBuilder::create(const VulkanDevice& d
       options.workGroupSize, 1u,
       std::min(limits.maxComputeWorkGroupSize[0], limits.maxComputeWorkGroupInvocations));
 
-  std::array<VkDescriptorSetLayoutBinding, L::kBindingCount> bindings{};
-  for (uint32_t i = 0; i < L::kBindingCount; ++i) {
-    bindings[i].binding = i;
-    bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    bindings[i].descriptorCount = 1;
-    bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-  }
-  auto setInfo = vkStruct<VkDescriptorSetLayoutCreateInfo>(
-      VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
-  setInfo.bindingCount = L::kBindingCount;
-  setInfo.pBindings = bindings.data();
-  VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
-  if (VkResult r = fn.vkCreateDescriptorSetLayout(dev, &setInfo, nullptr, &setLayout)) {
-    return error(r, "vkCreateDescriptorSetLayout");
-  }
-  o.setLayout = VkOwned<VkDescriptorSetLayout>(c, setLayout);
-
-  VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(L::PushConstants)};
-  auto layoutInfo =
-      vkStruct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
-  layoutInfo.setLayoutCount = 1;
-  layoutInfo.pSetLayouts = &setLayout;
-  layoutInfo.pushConstantRangeCount = 1;
-  layoutInfo.pPushConstantRanges = &push;
-  VkPipelineLayout pipelineLayout = VK_NULL_HANDLE;
-  if (VkResult r = fn.vkCreatePipelineLayout(dev, &layoutInfo, nullptr, &pipelineLayout)) {
-    return error(r, "vkCreatePipelineLayout");
-  }
-  o.pipelineLayout = VkOwned<VkPipelineLayout>(c, pipelineLayout);
+  if (auto e = createComputeLayouts(c, L::kBindingCount, sizeof(L::PushConstants), o.setLayout,
+                                    o.pipelineLayout))
+    return *e;
+  const VkDescriptorSetLayout setLayout = o.setLayout.get();
+  const VkPipelineLayout pipelineLayout = o.pipelineLayout.get();
 
   const std::array<std::span<const uint32_t>, kPassCount> code = {
       spirv::k_sdf_transform, spirv::k_sdf_cluster,  spirv::k_sdf_splat,

@@ -281,6 +281,51 @@ std::optional<Error> createComputeLayouts(const VkContext& ctx, uint32_t binding
   return std::nullopt;
 }
 
+std::optional<Error> createSubmitObjects(const VkContext& ctx, VkDescriptorSetLayout setLayout,
+                                         uint32_t bindings, VkSubmitObjects& out) {
+  const VkFunctions& fn = ctx.fn();
+  const VkDevice dev = ctx.handle();
+  const VkDescriptorPoolSize poolSize{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, bindings};
+  auto poolInfo =
+      vkStruct<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
+  poolInfo.maxSets = 1;
+  poolInfo.poolSizeCount = 1;
+  poolInfo.pPoolSizes = &poolSize;
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  if (VkResult r = fn.vkCreateDescriptorPool(dev, &poolInfo, nullptr, &pool))
+    return vkCallError(r, "vkCreateDescriptorPool");
+  out.descriptorPool = VkOwned<VkDescriptorPool>(ctx, pool);
+  auto setAlloc =
+      vkStruct<VkDescriptorSetAllocateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO);
+  setAlloc.descriptorPool = pool;
+  setAlloc.descriptorSetCount = 1;
+  setAlloc.pSetLayouts = &setLayout;
+  if (VkResult r = fn.vkAllocateDescriptorSets(dev, &setAlloc, &out.set))
+    return vkCallError(r, "vkAllocateDescriptorSets");
+
+  auto cmdPoolInfo = vkStruct<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
+  cmdPoolInfo.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  cmdPoolInfo.queueFamilyIndex = ctx.device().queueFamilyIndex;
+  VkCommandPool cmdPool = VK_NULL_HANDLE;
+  if (VkResult r = fn.vkCreateCommandPool(dev, &cmdPoolInfo, nullptr, &cmdPool))
+    return vkCallError(r, "vkCreateCommandPool");
+  out.commandPool = VkOwned<VkCommandPool>(ctx, cmdPool);
+  auto cmdAlloc =
+      vkStruct<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
+  cmdAlloc.commandPool = cmdPool;
+  cmdAlloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  cmdAlloc.commandBufferCount = 1;
+  if (VkResult r = fn.vkAllocateCommandBuffers(dev, &cmdAlloc, &out.cmd))
+    return vkCallError(r, "vkAllocateCommandBuffers");
+
+  auto fenceInfo = vkStruct<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
+  VkFence fence = VK_NULL_HANDLE;
+  if (VkResult r = fn.vkCreateFence(dev, &fenceInfo, nullptr, &fence))
+    return vkCallError(r, "vkCreateFence");
+  out.fence = VkOwned<VkFence>(ctx, fence);
+  return std::nullopt;
+}
+
 void recordMemoryBarrier(const VkContext& ctx, VkCommandBuffer cmd, VkPipelineStageFlags srcStage,
                          VkAccessFlags srcAccess, VkPipelineStageFlags dstStage,
                          VkAccessFlags dstAccess) {

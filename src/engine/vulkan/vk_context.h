@@ -224,6 +224,21 @@ std::optional<Error> createComputeLayouts(const VkContext& ctx, uint32_t binding
                                           VkOwned<VkDescriptorSetLayout>& setLayout,
                                           VkOwned<VkPipelineLayout>& pipelineLayout);
 
+// What a compute pass submitted one at a time owns besides its layouts and pipelines: one
+// descriptor set (its pool holds only it), one resettable command buffer for the context's queue
+// family, and the fence its submissions signal. Declared in destruction order reversed.
+struct VkSubmitObjects {
+  VkOwned<VkDescriptorPool> descriptorPool;  // owns `set`
+  VkDescriptorSet set = VK_NULL_HANDLE;
+  VkOwned<VkCommandPool> commandPool;    // owns `cmd`
+  VkCommandBuffer cmd = VK_NULL_HANDLE;  // re-recorded for every submission
+  VkOwned<VkFence> fence;                // signalled when a submission completes (polled)
+};
+// Makes them, the set of `setLayout` with its `bindings` storage buffers. Errors: vkCallError of
+// the failing call.
+std::optional<Error> createSubmitObjects(const VkContext& ctx, VkDescriptorSetLayout setLayout,
+                                         uint32_t bindings, VkSubmitObjects& out);
+
 // Records one global memory barrier into `cmd`.
 void recordMemoryBarrier(const VkContext& ctx, VkCommandBuffer cmd, VkPipelineStageFlags srcStage,
                          VkAccessFlags srcAccess, VkPipelineStageFlags dstStage,

@@ -24,11 +24,7 @@ struct VkMeshReadback::Objects {
   VkOwned<VkDescriptorSetLayout> setLayout;
   VkOwned<VkPipelineLayout> pipelineLayout;
   VkOwned<VkPipeline> pipeline;
-  VkOwned<VkDescriptorPool> descriptorPool;
-  VkDescriptorSet set = VK_NULL_HANDLE;  // freed with its pool
-  VkOwned<VkCommandPool> commandPool;
-  VkCommandBuffer cmd = VK_NULL_HANDLE;  // freed with its pool
-  VkOwned<VkFence> fence;
+  VkSubmitObjects submit;  // the descriptor set, command buffer and fence
   VkBufferAlloc gathered;  // grown to the largest mesh gathered
 };
 
@@ -43,9 +39,7 @@ Result<std::unique_ptr<VkMeshReadback>> VkMeshReadback::create(
   b->log_ = std::move(log);
   b->objects_ = std::make_unique<Objects>();
   const VkContext& c = *b->ctx_;
-  const VkFunctions& fn = c.fn();
   Objects& o = *b->objects_;
-  const VkDevice dev = c.handle();
   const VkPhysicalDeviceLimits& limits = c.properties().limits;
   b->groupSize_ =
       std::min({64u, limits.maxComputeWorkGroupSize[0], limits.maxComputeWorkGroupInvocations});
@@ -59,58 +53,21 @@ Result<std::unique_ptr<VkMeshReadback>> VkMeshReadback::create(
   if (!pipeline) return pipeline.error();
   o.pipeline = std::move(pipeline.value());
 
-  const VkDescriptorPoolSize poolSize{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3};
-  auto poolInfo =
-      vkStruct<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
-  poolInfo.maxSets = 1;
-  poolInfo.poolSizeCount = 1;
-  poolInfo.pPoolSizes = &poolSize;
-  VkDescriptorPool pool = VK_NULL_HANDLE;
-  if (VkResult r = fn.vkCreateDescriptorPool(dev, &poolInfo, nullptr, &pool))
-    return vkCallError(r, "vkCreateDescriptorPool");
-  o.descriptorPool = VkOwned<VkDescriptorPool>(c, pool);
-  auto setAlloc =
-      vkStruct<VkDescriptorSetAllocateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO);
-  setAlloc.descriptorPool = pool;
-  setAlloc.descriptorSetCount = 1;
-  setAlloc.pSetLayouts = &setLayout;
-  if (VkResult r = fn.vkAllocateDescriptorSets(dev, &setAlloc, &o.set))
-    return vkCallError(r, "vkAllocateDescriptorSets");
-
-  auto cmdPoolInfo = vkStruct<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
-  cmdPoolInfo.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  cmdPoolInfo.queueFamilyIndex = device.queueFamilyIndex;
-  VkCommandPool cmdPool = VK_NULL_HANDLE;
-  if (VkResult r = fn.vkCreateCommandPool(dev, &cmdPoolInfo, nullptr, &cmdPool))
-    return vkCallError(r, "vkCreateCommandPool");
-  o.commandPool = VkOwned<VkCommandPool>(c, cmdPool);
-  auto cmdAlloc =
-      vkStruct<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
-  cmdAlloc.commandPool = cmdPool;
-  cmdAlloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  cmdAlloc.commandBufferCount = 1;
-  if (VkResult r = fn.vkAllocateCommandBuffers(dev, &cmdAlloc, &o.cmd))
-    return vkCallError(r, "vkAllocateCommandBuffers");
-
-  auto fenceInfo = vkStruct<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
-  VkFence fence = VK_NULL_HANDLE;
-  if (VkResult r = fn.vkCreateFence(dev, &fenceInfo, nullptr, &fence))
-    return vkCallError(r, "vkCreateFence");
-  o.fence = VkOwned<VkFence>(c, fence);
+  if (auto e = createSubmitObjects(c, setLayout, 3, o.submit)) return *e;
   return b;
 }
 
 VkMeshReadback::~VkMeshReadback() {
   if (!ctx_ || !objects_ || !pending_) return;
   // The GPU may still write our buffer and read the app's: wait before anything goes.
-  const VkFence fence = objects_->fence.get();
+  const VkFence fence = objects_->submit.fence.get();
   if (ctx_->fn().vkWaitForFences(ctx_->handle(), 1, &fence, VK_TRUE, kDestroyWaitNs) ==
       VK_TIMEOUT) {
     // Destroying what a hung device still uses is worse than leaking it.
     objects_->gathered.buffer.release();
     objects_->gathered.memory.release();
-    objects_->commandPool.release();
-    objects_->fence.release();
+    objects_->submit.commandPool.release();
+    objects_->submit.fence.release();
   }
 }
 
@@ -156,7 +113,7 @@ Status VkMeshReadback::submit(uint64_t id, uint64_t generation, const VkMeshBuff
   std::array<VkWriteDescriptorSet, 3> writes{};
   for (uint32_t i = 0; i < writes.size(); ++i) {
     writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-    writes[i].dstSet = o.set;
+    writes[i].dstSet = o.submit.set;
     writes[i].dstBinding = i;
     writes[i].descriptorCount = 1;
     writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
@@ -165,7 +122,7 @@ Status VkMeshReadback::submit(uint64_t id, uint64_t generation, const VkMeshBuff
   // The set is not in use: no gather is in flight (pending_ is false).
   fn.vkUpdateDescriptorSets(c.handle(), uint32_t(writes.size()), writes.data(), 0, nullptr);
 
-  VkCommandBuffer cmd = o.cmd;
+  VkCommandBuffer cmd = o.submit.cmd;
   if (VkResult r = fn.vkResetCommandBuffer(cmd, 0)) return fail(r, "vkResetCommandBuffer");
   auto begin = vkStruct<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -176,7 +133,7 @@ Status VkMeshReadback::submit(uint64_t id, uint64_t generation, const VkMeshBuff
                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
   fn.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, o.pipeline.get());
   fn.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, o.pipelineLayout.get(), 0, 1,
-                             &o.set, 0, nullptr);
+                             &o.submit.set, 0, nullptr);
   const PushConstants pc{uint32_t(buffers.positionOffset / 4),
                          buffers.positionStride / 4,
                          buffers.vertexCount,
@@ -191,11 +148,11 @@ Status VkMeshReadback::submit(uint64_t id, uint64_t generation, const VkMeshBuff
                       VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
   if (VkResult r = fn.vkEndCommandBuffer(cmd)) return fail(r, "vkEndCommandBuffer");
 
-  const VkFence fence = o.fence.get();
+  const VkFence fence = o.submit.fence.get();
   if (VkResult r = fn.vkResetFences(c.handle(), 1, &fence)) return fail(r, "vkResetFences");
   auto submitInfo = vkStruct<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
   submitInfo.commandBufferCount = 1;
-  submitInfo.pCommandBuffers = &o.cmd;
+  submitInfo.pCommandBuffers = &o.submit.cmd;
   if (VkResult r = fn.vkQueueSubmit(c.queue(), 1, &submitInfo, fence))
     return fail(r, "vkQueueSubmit");
   pending_ = true;
@@ -228,7 +185,7 @@ std::optional<MeshReadback> VkMeshReadback::collect() {
 
 std::optional<MeshReadback> VkMeshReadback::poll() {
   if (failed_ || !pending_) return std::nullopt;
-  const VkFence fence = objects_->fence.get();
+  const VkFence fence = objects_->submit.fence.get();
   const VkResult r =
       simulateLost_ ? VK_ERROR_DEVICE_LOST : ctx_->fn().vkGetFenceStatus(ctx_->handle(), fence);
   if (r == VK_NOT_READY) return std::nullopt;
@@ -241,7 +198,7 @@ std::optional<MeshReadback> VkMeshReadback::poll() {
 
 std::optional<MeshReadback> VkMeshReadback::wait(uint64_t timeoutNs) {
   if (failed_ || !pending_ || simulateLost_) return poll();
-  const VkFence fence = objects_->fence.get();
+  const VkFence fence = objects_->submit.fence.get();
   const VkResult r = ctx_->fn().vkWaitForFences(ctx_->handle(), 1, &fence, VK_TRUE, timeoutNs);
   if (r == VK_TIMEOUT) return std::nullopt;
   if (r != VK_SUCCESS) {

@@ -60,50 +60,7 @@ Result<std::unique_ptr<VkSdfBuilder>> VkSdfBuilder::create(const VulkanDevice& d
     o.pipelines[p] = std::move(pipeline.value());
   }
 
-  const std::array<VkDescriptorPoolSize, 1> poolSizes = {
-      VkDescriptorPoolSize{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, L::kBindingCount}};
-  auto poolInfo =
-      vkStruct<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
-  poolInfo.maxSets = 1;
-  poolInfo.poolSizeCount = uint32_t(poolSizes.size());
-  poolInfo.pPoolSizes = poolSizes.data();
-  VkDescriptorPool pool = VK_NULL_HANDLE;
-  if (VkResult r = fn.vkCreateDescriptorPool(dev, &poolInfo, nullptr, &pool)) {
-    return error(r, "vkCreateDescriptorPool");
-  }
-  o.descriptorPool = VkOwned<VkDescriptorPool>(c, pool);
-  auto setAlloc =
-      vkStruct<VkDescriptorSetAllocateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO);
-  setAlloc.descriptorPool = pool;
-  setAlloc.descriptorSetCount = 1;
-  setAlloc.pSetLayouts = &setLayout;
-  if (VkResult r = fn.vkAllocateDescriptorSets(dev, &setAlloc, &o.set)) {
-    return error(r, "vkAllocateDescriptorSets");
-  }
-
-  auto cmdPoolInfo = vkStruct<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
-  cmdPoolInfo.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  cmdPoolInfo.queueFamilyIndex = device.queueFamilyIndex;
-  VkCommandPool cmdPool = VK_NULL_HANDLE;
-  if (VkResult r = fn.vkCreateCommandPool(dev, &cmdPoolInfo, nullptr, &cmdPool)) {
-    return error(r, "vkCreateCommandPool");
-  }
-  o.commandPool = VkOwned<VkCommandPool>(c, cmdPool);
-  auto cmdAlloc =
-      vkStruct<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
-  cmdAlloc.commandPool = cmdPool;
-  cmdAlloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  cmdAlloc.commandBufferCount = 1;
-  if (VkResult r = fn.vkAllocateCommandBuffers(dev, &cmdAlloc, &o.cmd)) {
-    return error(r, "vkAllocateCommandBuffers");
-  }
-
-  auto fenceInfo = vkStruct<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
-  VkFence fence = VK_NULL_HANDLE;
-  if (VkResult r = fn.vkCreateFence(dev, &fenceInfo, nullptr, &fence)) {
-    return error(r, "vkCreateFence");
-  }
-  o.fence = VkOwned<VkFence>(c, fence);
+  if (auto e = createSubmitObjects(c, setLayout, L::kBindingCount, o.submit)) return *e;
 
   uint32_t familyCount = 0;
   fn.vkGetPhysicalDeviceQueueFamilyProperties(device.physicalDevice, &familyCount, nullptr);
@@ -141,7 +98,7 @@ VkSdfBuilder::~VkSdfBuilder() {
     // The GPU may still read our buffers; destroying them first would be undefined behaviour.
     // Also after a failure: a simulated loss (or one reported by a poll while the submission
     // still runs) leaves real work in flight; on a lost device the wait returns at once.
-    const VkFence fence = objects_->fence.get();
+    const VkFence fence = objects_->submit.fence.get();
     const VkResult r =
         ctx_->fn().vkWaitForFences(ctx_->handle(), 1, &fence, VK_TRUE, 2'000'000'000ull);
     if (r == VK_TIMEOUT) {
@@ -150,10 +107,10 @@ VkSdfBuilder::~VkSdfBuilder() {
         b.buffer.release();
         b.memory.release();
       }
-      objects_->commandPool.release();
-      objects_->descriptorPool.release();
+      objects_->submit.commandPool.release();
+      objects_->submit.descriptorPool.release();
       for (auto& p : objects_->pipelines) p.release();
-      objects_->fence.release();
+      objects_->submit.fence.release();
       objects_->pipelineLayout.release();
       objects_->setLayout.release();
     }
@@ -241,7 +198,7 @@ void VkSdfBuilder::updateDescriptors() {
     if (meshSource_ == MeshSource::app && i == L::kPositions) infos[i].buffer = appMesh_.positions;
     if (meshSource_ == MeshSource::app && i == L::kIndices) infos[i].buffer = appMesh_.indices;
     writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-    writes[i].dstSet = objects_->set;
+    writes[i].dstSet = objects_->submit.set;
     writes[i].dstBinding = i;
     writes[i].descriptorCount = 1;
     writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;

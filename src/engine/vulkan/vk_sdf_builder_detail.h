@@ -123,12 +123,8 @@ struct VkSdfBuilder::Objects {
   VkOwned<VkDescriptorSetLayout> setLayout;  // the one layout every pass shares
   VkOwned<VkPipelineLayout> pipelineLayout;  // set 0 + 8 bytes of push constants
   std::array<VkOwned<VkPipeline>, vk_sdf_detail::kPassCount> pipelines;
-  VkOwned<VkDescriptorPool> descriptorPool;  // owns `set`
-  VkDescriptorSet set = VK_NULL_HANDLE;
-  VkOwned<VkCommandPool> commandPool;    // owns `cmd`; family = the borrowed queue's
-  VkCommandBuffer cmd = VK_NULL_HANDLE;  // re-recorded for every submission
-  VkOwned<VkFence> fence;                // signalled when a submission completes (polled)
-  VkOwned<VkQueryPool> timestamps;       // pass boundaries, only with options.profile
+  VkSubmitObjects submit;           // the descriptor set, command buffer and fence
+  VkOwned<VkQueryPool> timestamps;  // pass boundaries, only with options.profile
   std::array<VkBufferAlloc, vk_sdf_detail::kSlotCount> buffers;
   std::array<uint32_t, vk_sdf_detail::kSlotCount> kinds{};
   bool descriptorsDirty = true;

@@ -111,7 +111,7 @@ Status VkSdfBuilder::record(bool build, size_t pointCount, bool readBack) {
   updateDescriptors();
   const VkFunctions& fn = ctx_->fn();
   Objects& o = *objects_;
-  VkCommandBuffer cmd = o.cmd;
+  VkCommandBuffer cmd = o.submit.cmd;
   if (VkResult r = fn.vkResetCommandBuffer(cmd, 0)) return fail(r, "vkResetCommandBuffer");
   auto begin = vkStruct<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -131,7 +131,7 @@ Status VkSdfBuilder::record(bool build, size_t pointCount, bool readBack) {
   auto computeToCompute = [&] { barrier(kCompute, kWrite, kCompute, kRead | kWrite); };
 
   fn.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, o.pipelineLayout.get(), 0, 1,
-                             &o.set, 0, nullptr);
+                             &o.submit.set, 0, nullptr);
   auto dispatch = [&](Pass pass, size_t items, L::PushConstants pc) {
     fn.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, o.pipelines[pass].get());
     fn.vkCmdPushConstants(cmd, o.pipelineLayout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc),
@@ -304,11 +304,11 @@ Status VkSdfBuilder::record(bool build, size_t pointCount, bool readBack) {
 Status VkSdfBuilder::submitRecorded() {
   const VkFunctions& fn = ctx_->fn();
   if (simulateLost_) return fail(VK_ERROR_DEVICE_LOST, "vkQueueSubmit (simulated)");
-  const VkFence fence = objects_->fence.get();
+  const VkFence fence = objects_->submit.fence.get();
   if (VkResult r = fn.vkResetFences(ctx_->handle(), 1, &fence)) return fail(r, "vkResetFences");
   auto submit = vkStruct<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
   submit.commandBufferCount = 1;
-  submit.pCommandBuffers = &objects_->cmd;
+  submit.pCommandBuffers = &objects_->submit.cmd;
   if (VkResult r = fn.vkQueueSubmit(ctx_->queue(), 1, &submit, fence)) {
     return fail(r, "vkQueueSubmit");
   }
@@ -355,7 +355,7 @@ void VkSdfBuilder::collectResults() {
 SdfPoll VkSdfBuilder::poll() {
   if (failed_) return SdfPoll::failed;
   if (!pending_) return everSubmitted_ ? SdfPoll::ready : SdfPoll::idle;
-  const VkFence fence = objects_->fence.get();
+  const VkFence fence = objects_->submit.fence.get();
   const VkResult r =
       simulateLost_ ? VK_ERROR_DEVICE_LOST : ctx_->fn().vkGetFenceStatus(ctx_->handle(), fence);
   if (r == VK_NOT_READY) return SdfPoll::pending;
@@ -369,7 +369,7 @@ SdfPoll VkSdfBuilder::poll() {
 
 SdfPoll VkSdfBuilder::wait(uint64_t timeoutNs) {
   if (failed_ || !pending_ || simulateLost_) return poll();
-  const VkFence fence = objects_->fence.get();
+  const VkFence fence = objects_->submit.fence.get();
   const VkResult r = ctx_->fn().vkWaitForFences(ctx_->handle(), 1, &fence, VK_TRUE, timeoutNs);
   if (r == VK_TIMEOUT) return SdfPoll::pending;
   if (r != VK_SUCCESS) {

@@ -216,8 +216,6 @@ class GraspSession {
   // mesh the worker refused (the target goes on through its grab-box field only), triangles
   // left out because the device could not give their indices.
   std::vector<std::pair<uint64_t, std::string>> takeReadbackNotes();
-  // Whether device target `id` has its read-back mesh set up (a mesh like any other now).
-  bool readBack(uint64_t id) const;
   // How far from a hand (metres, wrist to the target's bounds) a device target's changes are
   // read back as they happen.
   static constexpr float kReadbackReach = 0.5f;
@@ -317,7 +315,6 @@ class GraspSession {
     bool shapeTarget = false;   // an analytic shape (addShapeTarget)
     bool deviceTarget = false;  // the deferred backend's mesh (addDeviceTarget)
     Mirror mirror = Mirror::none;
-    uint64_t readbackAsked = 0;    // generation of the newest readback asked
     uint64_t readbackApplied = 0;  // generation of the newest one handed to the worker
     bool readbackStale = false;    // changed since, while far from every hand
     std::optional<AnalyticShape> shape;

@@ -21,7 +21,6 @@ void GraspSession::askReadback(uint64_t id, Target& t) {
     }
     return;
   }
-  t.readbackAsked = generation;
   t.readbackStale = false;
   if (t.mirror == Mirror::none) {
     t.mirror = Mirror::asked;
@@ -80,7 +79,6 @@ void GraspSession::collectReadbacks() {
     if (r.generation <= t.readbackApplied || t.mirror == Mirror::failed) continue;
     t.readbackApplied = r.generation;
     ++t.version;
-    auto positions = std::make_shared<const std::vector<glm::vec3>>(std::move(r.positions));
     if (!r.indices.empty()) {
       // The first readback (or new index buffers): a set-up, as for a CPU mesh. The worker
       // checks what the device held (a NaN or an index out of range refuses it).
@@ -88,10 +86,11 @@ void GraspSession::collectReadbacks() {
       // two bytes of a 16-bit index buffer whose size is not a multiple of four, which no
       // 32-bit shader read reaches) are left out, as the device's own builds leave them out.
       const size_t before = r.indices.size() / 3;
+      const size_t vertices = r.positions.size();
       size_t kept = 0;
       for (size_t i = 0; i + 2 < r.indices.size(); i += 3) {
-        if (r.indices[i] >= positions->size() || r.indices[i + 1] >= positions->size() ||
-            r.indices[i + 2] >= positions->size())
+        if (r.indices[i] >= vertices || r.indices[i + 1] >= vertices ||
+            r.indices[i + 2] >= vertices)
           continue;
         for (size_t k = 0; k < 3; ++k) r.indices[3 * kept + k] = r.indices[i + k];
         ++kept;
@@ -103,18 +102,23 @@ void GraspSession::collectReadbacks() {
                       " triangles name an index its buffers do not hold (out of range, or in the "
                       "last two bytes of a 16-bit index buffer whose size is not a multiple of 4, "
                       "which shaders cannot read): they are left out");
-      auto indices = std::make_shared<const std::vector<uint32_t>>(std::move(r.indices));
-      t.vertexCount = positions->size();
-      worker_->addTarget(r.id, TriangleMesh{*positions, *indices});
-      if (deferredForMeshTargets_) t.deviceCopy = SharedMesh{positions, indices};
+      t.vertexCount = vertices;
+      TriangleMesh mesh{std::move(r.positions), std::move(r.indices)};
+      // The GPU's copy, where it builds meshes too, is the one copy made (this runs in the app's
+      // xrSyncActions); otherwise the worker takes the arrays as they came.
+      if (deferredForMeshTargets_)
+        t.deviceCopy = SharedMesh{std::make_shared<const std::vector<glm::vec3>>(mesh.positions),
+                                  std::make_shared<const std::vector<uint32_t>>(mesh.indices)};
+      worker_->addTarget(r.id, std::move(mesh));
       if (t.mirror != Mirror::settingUp) mirrorSetups_.push_back(r.id);
       t.mirror = Mirror::settingUp;
     } else if (t.mirror == Mirror::ready || t.mirror == Mirror::settingUp) {
-      if (positions->size() != t.vertexCount) continue;
+      if (r.positions.size() != t.vertexCount) continue;
+      if (t.deviceCopy.positions != nullptr)
+        t.deviceCopy.positions = std::make_shared<const std::vector<glm::vec3>>(r.positions);
       // The worker refits before its next build of the target (and refuses a pose that collapses
       // a triangle, keeping the last one, as for a CPU mesh).
-      worker_->updateVertices(r.id, *positions, t.version);
-      if (t.deviceCopy.positions != nullptr) t.deviceCopy.positions = std::move(positions);
+      worker_->updateVertices(r.id, std::move(r.positions), t.version);
     }
   }
   if (mirrorSetups_.empty()) return;
@@ -149,11 +153,6 @@ void GraspSession::collectReadbacks() {
 std::vector<std::pair<uint64_t, std::string>> GraspSession::takeReadbackNotes() {
   collectReadbacks();
   return std::exchange(readbackNotes_, {});
-}
-
-bool GraspSession::readBack(uint64_t id) const {
-  auto it = targets_.find(id);
-  return it != targets_.end() && it->second.mirror == Mirror::ready;
 }
 
 }  // namespace sdfg

@@ -55,7 +55,6 @@ Result<std::unique_ptr<VkGraspBackend>> VkGraspBackend::create(
     slot.main.shared = ownQueue == nullptr;
   }
   b->readback_ = makeReadback(appQueue, options.log);
-  b->readbackUnavailable_ = b->readback_ == nullptr;
   return b;
 }
 
@@ -108,7 +107,6 @@ void VkGraspBackend::adoptPrepared() {
     }
   }
   readback_ = std::move(made.readback);
-  readbackUnavailable_ = readback_ == nullptr;
   prep_ = Prep::warming;
 }
 
@@ -354,9 +352,10 @@ Status VkGraspBackend::setDeviceMesh(uint64_t id, const VkMeshBuffers& buffers) 
 Status VkGraspBackend::requestReadback(uint64_t id, uint64_t generation) {
   if (failed_) return Status::device_lost;
   if (deviceMeshes_.count(id) == 0) return Status::invalid_argument;
-  if (readbackUnavailable_ || (readback_ != nullptr && readback_->failed()))
+  // Null once prepared: it could not be made (logged). While the preparation runs, requests are
+  // kept until it has made the gatherer.
+  if (prep_ != Prep::making && (readback_ == nullptr || readback_->failed()))
     return Status::unsupported;
-  // Kept until the preparation has made the gatherer (readback_ null meanwhile).
   auto [it, inserted] = readbackWanted_.try_emplace(id, generation);
   if (inserted)
     readbackOrder_.push_back(id);
@@ -397,6 +396,17 @@ void VkGraspBackend::pumpReadbacks(bool sharedQueueFree) {
 
 std::vector<MeshReadback> VkGraspBackend::takeReadbacks() {
   collectReadback();
+  if (prep_ != Prep::making && (readback_ == nullptr || readback_->failed())) {
+    // No gatherer now (it could not be made, or the device failed it): the requests kept for it
+    // are refused, as empty readbacks, so that no owner waits for them.
+    for (const uint64_t id : readbackOrder_) {
+      auto wanted = readbackWanted_.find(id);
+      if (wanted != readbackWanted_.end())
+        readbacksDone_.push_back(MeshReadback{id, wanted->second, {}, {}});
+      readbackWanted_.erase(id);
+    }
+    readbackOrder_.clear();
+  }
   return std::exchange(readbacksDone_, {});
 }
 

@@ -152,7 +152,6 @@ class VkGraspBackend final : public DeferredSdfBackend {
   // Readbacks: the gatherer (on the app's queue; null until prepared, or when it could not be
   // made), the ids asked for in order with their newest generation, and the finished ones.
   std::unique_ptr<VkMeshReadback> readback_;
-  bool readbackUnavailable_ = false;
   std::deque<uint64_t> readbackOrder_;
   std::unordered_map<uint64_t, uint64_t> readbackWanted_;
   std::vector<MeshReadback> readbacksDone_;

@@ -188,9 +188,13 @@ TEST_CASE("A target in the app's Vulkan buffers (strided, 16-bit indices) is gra
       };
       const float curlBefore = curls();
 
-      // A skinned mesh's new pose: the sphere shrinks in place; nothing of the GPU reads it now
-      // (the hand holds still, so no build or readback is running).
-      REQUIRE(s.build.pendingGpuBuilds == 0);
+      // A skinned mesh's new pose: the sphere shrinks in place, written once nothing of the GPU
+      // reads the buffers: the mesh is read back (the target no longer pending), and the solve
+      // that follows has its build in (the hand holds still; from the copy, not the buffers).
+      REQUIRE(app.framesUntil([&] {
+        s = graspState(app, ext);
+        return setupInfo(app, ext).pendingCount == 0 && s.build.pendingGpuBuilds == 0;
+      }));
       writeVertices(m, sphere, 0.85f);
       REQUIRE(update(t, &m.desc) == XR_SUCCESS);
       // The fingers follow the smaller surface once the change is built (or read back).

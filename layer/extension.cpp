@@ -443,7 +443,11 @@ XrResult XRAPI_CALL SdfgXrCreateGraspTargetSDFG(XrSession session,
     }
     if (refusal == Refusal::none && status == Status::ok) {
       applyTargetSettings(*s, t->handle, settings);
-      applyTargetRole(*s, t->handle, role);
+      // A plane is a floor or a wall: scene geometry unless the app says otherwise.
+      const XrGraspTargetRoleInfoSDFG planeRole{XR_TYPE_GRASP_TARGET_ROLE_SDFG, nullptr,
+                                                XR_GRASP_TARGET_ROLE_SCENE_SDFG};
+      const bool plane = shapeInfo != nullptr && shape.kind == ShapeKind::plane;
+      applyTargetRole(*s, t->handle, role != nullptr ? role : plane ? &planeRole : nullptr);
       placeTarget(*s, *t, createInfo->placement.space, createInfo->placement.pose);
       s->targets[t->handle] = t;
     }
@@ -613,17 +617,23 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
     XrGraspFingerStateSDFG& out = state->fingers[f];
     const FingerState& fs = g.result.fingers[f];
     out.curl = held ? fs.curl : 0.0f;
-    out.inContact = held && fs.contact ? XR_TRUE : XR_FALSE;
+    // A finger is in contact when it rests on the held target; one resting on a table or a
+    // neighbour is not (its point and distance would be the other target's, not the held one's).
+    // A contact the engine could not attribute (touched 0: device targets before their readback,
+    // several in the box) counts as on the held target, as before scenes.
+    const uint64_t on = g.touched[size_t(f)];
+    const bool inContact = held && fs.contact && (on == g.target || on == 0);
+    out.inContact = inContact ? XR_TRUE : XR_FALSE;
     // Version 2: the touching sphere (in the corrected hand: the hand may have been moved out
     // first)'s centre and the signed distance there (contact.h).
     const FingerContact& c = g.contacts[f];
-    const bool honest = held && fs.contact && c.valid;
+    const bool honest = inContact && c.valid;
     const glm::vec3 p =
-        honest ? c.center
-        : held ? (g.objectFromHand * g.result.handCorrection).transformPoint(fs.contactPoint)
-               : glm::vec3(0.0f);
+        honest      ? c.center
+        : inContact ? (g.objectFromHand * g.result.handCorrection).transformPoint(fs.contactPoint)
+                    : glm::vec3(0.0f);
     out.contactPoint = {p.x, p.y, p.z};
-    out.distance = honest ? c.distance : held ? fs.distance : 0.0f;
+    out.distance = honest ? c.distance : inContact ? fs.distance : 0.0f;
   }
   writeGraspStateV2(*s, hand, held, state);
   if (auto* touches = findInChain<XrGraspTouchesSDFG>(state->next, XR_TYPE_GRASP_TOUCHES_SDFG))
@@ -708,8 +718,8 @@ XrResult XRAPI_CALL SdfgXrSetGraspOptionsSDFG(XrSession session,
   if (o.curlStep != 0.0f) settings.solverOptions.da = o.curlStep;
   if (o.grabThreshold != 0.0f) settings.grabThreshold = o.grabThreshold;
   float blendTime = s->instance->config.offsetBlendTime;
-  clearance.apply(settings, blendTime);
-  outer.apply(settings);
+  clearance.apply(settings, blendTime, s->settings, s->offsets.blendTime);
+  outer.apply(settings, s->settings);
   if (Status st = s->grasp->configure(settings); st != Status::ok) {
     lock.unlock();
     return logError(st == Status::invalid_argument && solver == XR_GRASP_SOLVER_OURS_SDFG

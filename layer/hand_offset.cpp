@@ -23,10 +23,20 @@ bool zeroOrUpTo(float v, float hi) {
 
 }  // namespace
 
-void ClearanceRequest::apply(GraspSettings& settings, float& blendTime) const {
-  if (!present) return;
-  const XrGraspClearanceOptionsSDFG& o = options;
+void ClearanceRequest::apply(GraspSettings& settings, float& blendTime,
+                             const GraspSettings& current, float currentBlendTime) const {
   SolverOptions& so = settings.solverOptions;
+  if (!present) {
+    const SolverOptions& was = current.solverOptions;
+    so.clearance = was.clearance;
+    so.clearanceBound = was.clearanceBound;
+    so.approach = was.approach;
+    so.approachRange = was.approachRange;
+    so.approachMaxAngle = was.approachMaxAngle;
+    blendTime = currentBlendTime;
+    return;
+  }
+  const XrGraspClearanceOptionsSDFG& o = options;
   if (o.clearance != XR_GRASP_SWITCH_DEFAULT_SDFG)
     so.clearance = o.clearance == XR_GRASP_SWITCH_ON_SDFG;
   if (o.maxCorrection != 0.0f) so.clearanceBound = o.maxCorrection;
@@ -80,8 +90,12 @@ XrResult readClearanceOptions(const char* cmd, const void* next, ClearanceReques
   return XR_SUCCESS;
 }
 
-void OuterHandRequest::apply(GraspSettings& settings) const {
-  if (!present) return;
+void OuterHandRequest::apply(GraspSettings& settings, const GraspSettings& current) const {
+  if (!present) {
+    settings.outerHand = current.outerHand;
+    settings.outerOptions = current.outerOptions;
+    return;
+  }
   if (options.outerHand != XR_GRASP_SWITCH_DEFAULT_SDFG)
     settings.outerHand = options.outerHand == XR_GRASP_SWITCH_ON_SDFG;
   if (options.releaseDistance != 0.0f)

@@ -25,14 +25,18 @@ struct HandOffsets {
 struct ClearanceRequest {
   bool present = false;
   XrGraspClearanceOptionsSDFG options{};
-  void apply(GraspSettings& settings, float& blendTime) const;
+  // Absent, the clearance options of `current` (and its blend time) are kept: a call of
+  // xrSetGraspOptionsSDFG without the struct leaves them as they are.
+  void apply(GraspSettings& settings, float& blendTime, const GraspSettings& current,
+             float currentBlendTime) const;
 };
 
 // What XrGraspOuterHandOptionsSDFG asked for, checked; applied to the settings by apply().
 struct OuterHandRequest {
   bool present = false;
   XrGraspOuterHandOptionsSDFG options{};
-  void apply(GraspSettings& settings) const;
+  // Absent, the outer-hand options of `current` are kept.
+  void apply(GraspSettings& settings, const GraspSettings& current) const;
 };
 
 // Checks the XrGraspOuterHandOptionsSDFG chained on `next`, if any: XR_SUCCESS (and `out` set)

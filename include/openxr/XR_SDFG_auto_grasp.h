@@ -177,11 +177,12 @@ typedef struct XrGraspStateGetInfoSDFG {
 
 typedef struct XrGraspFingerStateSDFG {
   float curl;               // 0 open .. 1 closed: how far the finger is allowed to close
-  XrBool32 inContact;       // it stopped on the surface (XR_FALSE: it closes without touching)
+  XrBool32 inContact;       // it stopped on the held target's surface (XR_FALSE: it closes
+                            // without touching, or rests on another target, see version 3)
   XrVector3f contactPoint;  // target frame: centre of the touching sphere (any part of the finger,
-                            // not only its tip; see version 2 below)
+                            // not only its tip; see version 2 below); zero without inContact
   float distance;           // signed distance of the target at contactPoint (about the radius of
-                            // the finger there)
+                            // the finger there); zero without inContact
 } XrGraspFingerStateSDFG;
 
 // Output. Fingers in thumb, index, middle, ring, little order.
@@ -241,7 +242,10 @@ typedef enum XrGraspSolverSDFG {
   XR_GRASP_SOLVER_MAX_ENUM_SDFG = 0x7FFFFFFF
 } XrGraspSolverSDFG;
 
-// Options of one session, applied from the next grab. A zero field keeps the layer's default.
+// Options of one session, applied from the next grab. Each call sets every field of this struct
+// (a zero field: the layer's default); the option structs chained on `next`
+// (XrGraspClearanceOptionsSDFG, XrGraspOuterHandOptionsSDFG) that a call leaves out keep the
+// values an earlier call gave them.
 typedef struct XrGraspOptionsSDFG {
   XrStructureType type;  // XR_TYPE_GRASP_OPTIONS_SDFG
   const void* XR_MAY_ALIAS next;
@@ -532,13 +536,14 @@ typedef XrResult(XRAPI_PTR* PFN_xrGetGraspTargetStateSDFG)(XrGraspTargetSDFG tar
 //
 // Which target a grab takes (the rule, deterministic). A finger touches the target that owns the
 // nearest surface at its touching sphere; the palm touches a target whose surface is within 2 cm
-// of the palm joint's sphere (a flat object under the palm, a comb on a table, is often touched by
-// no finger: they close past it onto the table). Among the targets in the grab box that the hand
-// may take (role GRASPABLE and, for that hand, XrGraspTargetSettingsSDFG::graspableBy):
-//   1. the one the palm faces (the first surface on the ray from the palm joint along the palm's
-//      normal, within 30 cm), if a finger touches it or its surface is within 3 cm of the palm
-//      joint's sphere: fingers that wrap past it onto a neighbour (a mug beside a mug, a spoon
-//      standing in a mug) do not outvote what the palm is turned to;
+// of the palm joint's sphere, and the target it faces (the first surface on the ray from the palm
+// joint along the palm's normal, within 30 cm) within 3 cm (a flat object under the palm, a comb
+// on a table, is often touched by no finger: they close past it onto the table). Among the
+// targets in the grab box that the hand may take (role GRASPABLE and, for that hand,
+// XrGraspTargetSettingsSDFG::graspableBy):
+//   1. the one the palm faces, if the hand touches it (a finger, or the palm within 3 cm):
+//      fingers that wrap past it onto a neighbour (a mug beside a mug, a spoon standing in a mug)
+//      do not outvote what the palm is turned to;
 //   2. else, among those the hand touches, the one the most fingers touch;
 //   3. between those, the one whose surface is nearest the palm joint's centre (exact distance);
 //   4. between those, the one created first.
@@ -569,7 +574,8 @@ typedef enum XrGraspTargetRoleSDFG {
   XR_GRASP_TARGET_ROLE_MAX_ENUM_SDFG = 0x7FFFFFFF
 } XrGraspTargetRoleSDFG;
 
-// A target's role: chained on XrGraspTargetCreateInfoSDFG::next (without it: GRASPABLE), or on
+// A target's role: chained on XrGraspTargetCreateInfoSDFG::next (without it: GRASPABLE, and SCENE
+// for a plane), or on
 // XrGraspTargetSettingsSDFG::next given to xrSetGraspTargetSettingsSDFG (from the next
 // xrSyncActions; a hand holding a target that is no longer GRASPABLE lets go, with a
 // XR_GRASP_CHANGE_REASON_RELEASED_SDFG event). A role outside the listed values:
@@ -585,7 +591,8 @@ typedef enum XrGraspShapeTypeSDFG {
   // A box centred on the target frame's origin, edges along its axes (halfExtents).
   XR_GRASP_SHAPE_TYPE_BOX_SDFG = 1,
   // The target frame's y = 0 plane, solid below it (its outward normal is +Y): a floor, or a wall
-  // placed with +Y toward the room. halfExtents must be zero.
+  // placed with +Y toward the room. halfExtents must be zero. Its role is SCENE unless the app
+  // chains another (XrGraspTargetRoleInfoSDFG): a floor registered without a role is never taken.
   XR_GRASP_SHAPE_TYPE_PLANE_SDFG = 2,
   XR_GRASP_SHAPE_TYPE_MAX_ENUM_SDFG = 0x7FFFFFFF
 } XrGraspShapeTypeSDFG;
@@ -634,8 +641,9 @@ typedef struct XrGraspTouchesSDFG {
   XrBool32 isClosed;
   // Per finger (thumb, index, middle, ring, little), the target its contact is on;
   // XR_NULL_HANDLE where the finger touches nothing (or the hand is not closed). A finger on a
-  // target other than the held one has no contact in XrGraspContactsSDFG (whose points are in
-  // the held target's frame).
+  // target other than the held one has no contact anywhere else: it is not inContact in
+  // XrGraspFingerStateSDFG and its part is NONE in XrGraspContactsSDFG (both describe the held
+  // target, in its frame).
   XrGraspTargetSDFG touched[XR_GRASP_FINGER_COUNT_SDFG];
 } XrGraspTouchesSDFG;
 

@@ -265,6 +265,15 @@ TEST_CASE("Outer hand: the configuration key and the options switch turn it off"
     const std::vector<Frame> on = drive(table, grips, switchTo(XR_GRASP_SWITCH_ON_SDFG));
     CHECK(depthIn(on.back().joints, table) <= 0.001f);
   }
+  SECTION("a later call without the outer hand's options keeps it off") {
+    const std::vector<Frame> off = drive(table, grips, [](const App& app, const Ext& ext) {
+      REQUIRE(setOuter(app, ext, XR_GRASP_SWITCH_OFF_SDFG) == XR_SUCCESS);
+      XrGraspOptionsSDFG o{XR_TYPE_GRASP_OPTIONS_SDFG};
+      o.grabThreshold = 0.7f;
+      REQUIRE(ext.options(app.session, &o) == XR_SUCCESS);
+    });
+    CHECK(depthIn(off.back().joints, table) > 0.02f);
+  }
   SECTION("refused options change nothing") {
     const std::vector<Frame> shown = drive(table, grips, [](const App& app, const Ext& ext) {
       // Off together with a bad value: refused, so the outer hand stays on.

@@ -98,6 +98,39 @@ TEST_CASE("A squeeze with only scene geometry in reach closes on it and holds no
   CHECK(validationLog().empty());
 }
 
+TEST_CASE("A plane registered without a role is scene geometry: a squeeze on a floor takes nothing",
+          "[layer][scenes]") {
+  const TestMesh far = makeIcosphere(0.02f, 2);
+  GraspRun run(far, {{0, 0, 0, 1}, {5.0f, 0.0f, 0.0f}}, kGrip);
+  // The floor's surface where tableUnderPalm() puts the table's top: 3 mm under the open hand.
+  const Table table = tableUnderPalm(kGrip);
+  const XrPosef floorPose = awayFromPalm(kGrip, table.pose, -table.half.y);
+  const bool graspable = GENERATE(false, true);
+  CAPTURE(graspable);
+  XrGraspTargetShapeSDFG plane{
+      XR_TYPE_GRASP_TARGET_SHAPE_SDFG, nullptr, XR_GRASP_SHAPE_TYPE_PLANE_SDFG, {0, 0, 0}};
+  // An app may still make a plane graspable by saying so.
+  XrGraspTargetRoleInfoSDFG role{XR_TYPE_GRASP_TARGET_ROLE_SDFG, &plane,
+                                 XR_GRASP_TARGET_ROLE_GRASPABLE_SDFG};
+  XrGraspTargetCreateInfoSDFG ci{XR_TYPE_GRASP_TARGET_CREATE_INFO_SDFG,
+                                 graspable ? static_cast<const void*>(&role) : &plane};
+  ci.placement = {XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, run.app->local, floorPose};
+  XrGraspTargetSDFG floor = XR_NULL_HANDLE;
+  REQUIRE(run.ext->create(run.app->session, &ci, &floor) == XR_SUCCESS);
+  REQUIRE(runUntil(*run.app, [&] { return touchesOf(run).touches.isClosed == XR_TRUE; }));
+  const Touches t = touchesOf(run);
+  CHECK(fingersOn(t.touches).count(floor) == 1);
+  if (graspable) {
+    CHECK(t.state.isGrasping);
+    CHECK(t.state.target == floor);
+  } else {
+    CHECK_FALSE(t.state.isGrasping);
+    CHECK(t.state.target == XR_NULL_HANDLE);
+    for (const XrGraspFingerStateSDFG& f : t.state.fingers) CHECK_FALSE(f.inContact);
+  }
+  CHECK(validationLog().empty());
+}
+
 TEST_CASE("A flat object on a table: the grab takes the object, no hand part enters the table",
           "[layer][scenes]") {
   // A flat bar (a comb's size: 12 x 0.8 x 3 cm) lying on the table under the palm.
@@ -127,6 +160,16 @@ TEST_CASE("A flat object on a table: the grab takes the object, no hand part ent
     REQUIRE(t.state.isGrasping);
     CHECK(t.state.target == run.target);
     CHECK(on.count(top) == 1);
+  }
+  // Version 1 fields: a finger that closed past the bar onto the table is not in contact (its
+  // point and distance would be the table's), one on the bar has the bar's exact distance.
+  const AnalyticShape barShape{ShapeKind::box, {0.06f, 0.004f, 0.015f}};
+  for (int f = 0; f < 5; ++f) {
+    const XrGraspFingerStateSDFG& v1 = t.state.fingers[f];
+    if (t.touches.touched[f] != run.target) CHECK_FALSE(v1.inContact);
+    if (!v1.inContact) continue;
+    const glm::vec3 c(v1.contactPoint.x, v1.contactPoint.y, v1.contactPoint.z);
+    CHECK(std::abs(barShape.signedDistance(c) - v1.distance) <= 0.0002f);
   }
   Joints joints;
   REQUIRE(locateJoints(*run.app, run.tracker, joints) == XR_SUCCESS);
@@ -286,3 +329,4 @@ TEST_CASE("Bad roles and shapes are refused and change nothing", "[layer][scenes
   CHECK(set(box, &s) == XR_ERROR_VALIDATION_FAILURE);
   CHECK(validationLog().empty());
 }
+

@@ -667,6 +667,9 @@ void GraspWorker::chooseAndContact(const Job& job, std::span<const SceneMember> 
   for (int f = 0; f < kFingerCount; ++f) {
     const int m = choice.touched[size_t(f)];
     done.touched[size_t(f)] = m >= 0 ? scene[size_t(m)].id : 0;
+    // A device target alone in the box (no CPU mesh yet): what a finger stopped on is it.
+    if (scene.empty() && job.members.size() == 1 && done.result.fingers[size_t(f)].contact)
+      done.touched[size_t(f)] = job.members[0].target;
   }
   // A held target stays held; else the choice (none: the hand holds nothing).
   size_t chosenMember = job.members.size();

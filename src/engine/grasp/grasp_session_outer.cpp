@@ -73,9 +73,11 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
                 local, radii);
   }
   JointPoses shown = local;
+  std::array<bool, kFingerCount> rigidFingers{};
   if (hand.grasp.shown()) {
     const ShownCurls c = shownCurls(hand.grasp.result, hand.model.estimateCurls(local));
     replaceFingers(hand.model, c.curls, c.replace, Pose{}, shown);
+    rigidFingers = c.replace;
   }
 
   // What is near: around the tracked palm and the last shown one.
@@ -140,6 +142,7 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
   job.radii = radii;
   job.time = double(frame.time) * 1e-9;
   job.model = view.model;
+  job.rigidFingers = rigidFingers;
   job.options = settings_.outerOptions;
   const Pose worldFromShown = frame.worldFromWrist * view.fallback.offset;
   if (held != 0) {

@@ -364,6 +364,7 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
     in.radii = &job.radii;
     in.time = job.time;
     in.attached = parts;
+    in.rigidFingers = job.rigidFingers;
     const SceneExactSource source(scene);
     auto r = o.hand->update(in, scene.empty() ? nullptr : &source);
     if (r)

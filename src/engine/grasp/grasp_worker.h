@@ -174,6 +174,7 @@ class GraspWorker {
     // surface is sampled here, once per target and vertex version.
     uint64_t attached = 0;
     Pose wristFromAttached;
+    std::array<bool, kFingerCount> rigidFingers{};  // OuterHandInput::rigidFingers
     HandModel model = HandModel::defaultAdult(Hand::right);
     OuterHandOptions options{};
   };

@@ -27,10 +27,23 @@ void advanceHandOffset(HandOffset& o, const HandGrasp& g, int64_t now, float ble
       glm::normalize(glm::slerp(o.current.orientation, o.solved.orientation, follow));
 }
 
+namespace {
+
+// Smoothstep: the hand starts and ends its move at rest.
+float blendWeight(float blend) {
+  return blend * blend * (3.0f - 2.0f * blend);
+}
+
+}  // namespace
+
+float shownClosing(const HandOffset& o) {
+  constexpr float kStill = 1e-4f;  // metres: a correction this small is shown at once
+  return o.displacement <= kStill ? 1.0f : blendWeight(o.blend);
+}
+
 Pose shownHandOffset(const HandOffset& o) {
   if (o.blend <= 0.0f) return Pose{};
-  // Smoothstep: the hand starts and ends its move at rest.
-  const float w = o.blend * o.blend * (3.0f - 2.0f * o.blend);
+  const float w = blendWeight(o.blend);
   Pose p;
   p.position = o.current.position * w;
   p.orientation =

@@ -39,6 +39,12 @@ void advanceHandOffset(HandOffset& offset, const HandGrasp& grasp, int64_t now, 
 // The offset shown now, in the wrist frame (identity when nothing is blended in).
 Pose shownHandOffset(const HandOffset& offset);
 
+// How far a new grasp's fingers are shown closed, 0..1: they close while the hand moves to the
+// grasp's correction (the same smoothstep), since the solve put them on the surface from the
+// corrected hand; closed at the uncorrected one they would be inside (by as much as the hand is
+// still to move). 1 when the correction moves the hand by nothing.
+float shownClosing(const HandOffset& offset);
+
 // Moves every joint (any base space; the wrist is joints[wrist]) by `offset` in the wrist frame.
 void applyHandOffset(const Pose& offset, JointPoses& joints);
 

@@ -443,7 +443,7 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
   for (int i = 0; i < count; ++i) {
     const HandPart& p = parts[size_t(i)];
     const int f = fingerOf(p.joint);
-    if (f < 0 || isMetacarpal(p.joint)) {
+    if (f < 0 || isMetacarpal(p.joint) || in.rigidFingers[size_t(f)]) {
       rigid.local.push_back(p.centre);
       rigid.radius.push_back(p.coverRadius);
     } else {
@@ -451,9 +451,11 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
       fingerRadius[size_t(f)].push_back(p.coverRadius);
     }
   }
+  // A held object's surface keeps no margin: it may rest on a surface, not enter it.
+  const float attachedRadius = -options_.margin;
   for (const HandPart& p : in.attached) {
     rigid.local.push_back(p.centre);
-    rigid.radius.push_back(p.coverRadius);
+    rigid.radius.push_back(p.coverRadius + attachedRadius);
   }
   const glm::vec3 pivot = (*in.joints)[size_t(Joint::palm)].position;
   const FingerCurls user = model_.estimateCurls(*in.joints);
@@ -487,7 +489,7 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
     }
     for (const HandPart& p : in.attached) {
       world.push_back(wrist.transformPoint(p.centre));
-      radii.push_back(p.coverRadius);
+      radii.push_back(p.coverRadius + attachedRadius);
     }
     probe.reset(world.size());
     return probe(world, radii, reach, kInf);
@@ -605,6 +607,11 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
   Probe fingerProbe(*scene);
   std::vector<float> drop;
   for (int f = 0; f < kFingerCount; ++f) {
+    if (in.rigidFingers[size_t(f)]) {
+      curl_[size_t(f)] = user[size_t(f)];
+      capped_[size_t(f)] = false;
+      continue;
+    }
     const FingerRig& rig = rigs_[size_t(f)];
     const float target = user[size_t(f)];
     float a = curl_[size_t(f)];

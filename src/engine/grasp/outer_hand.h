@@ -58,8 +58,12 @@ struct OuterHandInput {
   const std::array<float, kJointCount>* radii = nullptr;
   double time = 0.0;  // seconds, any origin (the blend's clock)
   // Parts of a held object, wrist frame: part of the hand, kept out of everything else (the
-  // caller leaves the held object itself out of `scene`).
+  // caller leaves the held object itself out of `scene`). They may rest on a surface (a held
+  // object lying on a table where the app put it does not push the hand off it) but not enter it.
   std::span<const HandPart> attached{};
+  // Fingers that close on a grasp (the grasp's solve, clear of the whole scene): moved with the
+  // rigid part as given, never re-curled, so they stay on what they hold.
+  std::array<bool, kFingerCount> rigidFingers{};
 };
 
 struct OuterHandResult {

@@ -18,7 +18,8 @@ struct ShownCurls {
 };
 
 // `grasp`: the solve shown; `user`: the user's own curl per finger (squeeze, or estimateCurls of a
-// tracked hand).
-ShownCurls shownCurls(const GraspResult& grasp, const FingerCurls& user);
+// tracked hand); `closing` (0..1): how far toward the contact curls the fingers have closed
+// (shownClosing(): while the hand moves to the grasp's correction).
+ShownCurls shownCurls(const GraspResult& grasp, const FingerCurls& user, float closing = 1.0f);
 
 }  // namespace sdfg

@@ -14,6 +14,7 @@ ShownHand takeShownHand(const GraspSession& session, Hand hand, const HandOffset
   v.repose = session.reposeCorrection(hand);
   v.offsetShown = offset.blend > 0.0f;
   v.offset = shownHandOffset(offset);
+  v.closing = shownClosing(offset);
   v.squeeze = squeeze;
   v.outer = session.outerView(hand);
   return v;
@@ -47,7 +48,7 @@ void drawTrackedHand(const ShownHand& view, JointPoses& joints,
     whole = true;
   }
   if (view.shown) {
-    const ShownCurls c = shownCurls(view.result, view.model.estimateCurls(local));
+    const ShownCurls c = shownCurls(view.result, view.model.estimateCurls(local), view.closing);
     replaceFingers(view.model, c.curls, c.replace, baseFromWrist, joints);
     for (int f = 0; f < kFingerCount; ++f) {
       if (!c.replace[size_t(f)]) continue;
@@ -71,7 +72,7 @@ void drawGripHand(const ShownHand& view, const Pose& baseFromGrip, MotionRange r
   const FingerCurls user = curlsFromSqueeze(view.squeeze, range);
   placeJoints(view.model, user, baseFromWrist, joints, radii);
   if (view.shown) {
-    const ShownCurls c = shownCurls(view.result, user);
+    const ShownCurls c = shownCurls(view.result, user, view.closing);
     replaceFingers(view.model, c.curls, c.replace, baseFromWrist, joints);
   }
   if (outer.changes) capFingers(view.outer.model, outer, baseFromWrist, joints);

@@ -28,6 +28,7 @@ struct ShownHand {
   std::optional<Pose> repose;
   Pose offset;               // shownHandOffset(): the whole hand moves by it (wrist frame)
   bool offsetShown = false;  // blend > 0
+  float closing = 1.0f;      // shownClosing(): how far the grasp's fingers are closed
   float squeeze = 0.0f;      // the grab input at the update: a synthesized hand's curl
   // The outer hand (grasp/outer_view.h): applied first, the grasp drawn on the hand it shows.
   OuterView outer;

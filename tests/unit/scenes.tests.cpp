@@ -51,7 +51,7 @@ double closestVertex(const TriangleMesh& a, const TriangleMesh& b) {
 
 TEST_CASE("The scenes place their objects as documented", "[core][scenes]") {
   const std::vector<BenchScene> scenes = embeddedScenes();
-  REQUIRE(scenes.size() == 6);
+  REQUIRE(scenes.size() == 8);
   for (const BenchScene& s : scenes) {
     CAPTURE(s.name);
     REQUIRE(s.reachedFor < s.objects.size());
@@ -70,11 +70,20 @@ TEST_CASE("The scenes place their objects as documented", "[core][scenes]") {
     const Aabb b = computeBounds(worldMesh(sceneNamed(scenes, "torus/table").objects[0]).positions);
     CHECK(b.min.y == Approx(0.0f).margin(1e-5));
   }
-  SECTION("the two mugs are 5 mm apart") {
+  SECTION("the two mugs are 5 mm apart (1 cm in mug-near-mug)") {
     const BenchScene& s = sceneNamed(scenes, "mug-beside-mug");
     const double gap =
         closestVertex(worldMesh(objectNamed(s, "mug-2")), worldMesh(objectNamed(s, "mug")));
     CHECK(gap == Approx(0.005).margin(5e-4));
+    const BenchScene& near = sceneNamed(scenes, "mug-near-mug");
+    CHECK(closestVertex(worldMesh(objectNamed(near, "mug-2")),
+                        worldMesh(objectNamed(near, "mug"))) == Approx(0.01).margin(5e-4));
+  }
+  SECTION("the ruler lies flat on the table") {
+    const BenchScene& s = sceneNamed(scenes, "ruler-on-table");
+    const Aabb b = computeBounds(worldMesh(objectNamed(s, "ruler")).positions);
+    CHECK(b.min.y == Approx(0.0f).margin(1e-5));
+    CHECK(b.max.y == Approx(0.003f).margin(1e-5));
   }
   SECTION("the spoon stands in the mug touching neither wall nor floor") {
     const BenchScene& s = sceneNamed(scenes, "spoon-in-mug");

@@ -99,6 +99,9 @@ tools::Json scenesJson(const std::vector<SceneRow>& rows) {
                              {"max", jsonNumber(f.held.penetrationMaxMm)}};
     row["early_stops"] = f.held.earlyStops;
     row["pass_through"] = f.held.passThroughs;
+    // "ours": the version 1 contacts on the object taken against its exact distance.
+    row["v1_contacts"] = f.v1Contacts;
+    row["v1_residual_max_mm"] = jsonNumber(f.v1ResidualMaxMm);
     out.push_back(std::move(row));
   }
   return out;

@@ -18,6 +18,7 @@
 #include "eval/placements.h"
 #include "eval/solver_physics.h"
 #include "eval/strategies.h"
+#include "grasp/contact.h"
 #include "grasp/scene_exact_source.h"
 #include "grasp/target_choice.h"
 #include "mesh/mesh_distance.h"
@@ -121,6 +122,10 @@ struct Graded {
   int deepestObject = -1;
   GraspMetrics metrics;  // on the graded object, with the fingers judged on every object
   std::array<int, kFingerCount> fingerOn{-1, -1, -1, -1, -1};  // nearest object to each contact
+  float wholeMm = 0.0f;  // approaching, open hand inside: the whole hand into any object
+  bool exceeded = false;
+  int v1Contacts = 0;
+  float v1ResidualMm = 0.0f;
 };
 
 // The single-object metrics of the graded object, with what a finger does judged on every
@@ -204,15 +209,34 @@ Result<SceneFigures> measureScene(const BenchScene& scene, const SceneRun& run) 
   const bool sceneAware = run.method == "ours";
 
   const Prepared& reached = objects[scene.reachedFor];
-  const std::vector<Placement> placements = generatePlacements(
-      reached.world, *reached.exact, hand, run.box, run.placements, run.seed,
-      [&](const Pose& worldFromHand) {
-        for (size_t i = 0; i < objects.size(); ++i) {
-          if (i != scene.reachedFor && openHandIntersects(*objects[i].exact, hand, worldFromHand))
-            return true;
-        }
-        return false;
-      });
+  auto inAnother = [&](const Pose& worldFromHand) {
+    for (size_t i = 0; i < objects.size(); ++i) {
+      if (i != scene.reachedFor && openHandIntersects(*objects[i].exact, hand, worldFromHand))
+        return true;
+    }
+    return false;
+  };
+  std::vector<Placement> placements;
+  std::vector<char> openInside;
+  std::vector<float> openMm;  // the open hand's depth in the object reached for
+  if (run.approaching) {
+    // Drawn in order, those whose open hand is in another object left out: a seed gives the same
+    // placements on every machine. Ten times as many draws as asked covers the scenes' losses
+    // (in mug-near-mug, about half the hands reaching for the mug are in the table or the other).
+    for (const ApproachPlacement& a : generateApproachingPlacements(
+             reached.world, *reached.exact, hand, run.box, 10 * run.placements, run.seed)) {
+      if (placements.size() == size_t(run.placements)) break;
+      if (inAnother(a.placement.objectFromHand)) continue;
+      placements.push_back(a.placement);
+      openInside.push_back(a.openInside ? 1 : 0);
+      openMm.push_back(a.openPenetrationMm);
+    }
+  } else {
+    placements = generatePlacements(reached.world, *reached.exact, hand, run.box, run.placements,
+                                    run.seed, inAnother);
+    openInside.assign(placements.size(), 0);
+    openMm.assign(placements.size(), 0.0f);
+  }
   if (placements.size() < size_t(run.placements)) {
     return makeError(Status::invalid_argument, "scene " + scene.name + ": only " +
                                                    std::to_string(placements.size()) + " of " +
@@ -280,11 +304,27 @@ Result<SceneFigures> measureScene(const BenchScene& scene, const SceneRun& run) 
                              std::to_string(p) + " (" + toString(s) + ")");
         continue;
       }
+      g.exceeded = result.clearanceExceeded;
       if (sceneAware) {
         const GraspChoice choice = chooseTarget(members, exact, result, handFromPalm.position,
                                                 hand.jointRadius(Joint::palm),
                                                 palmFacing(handFromPalm), reach + kTouchReach);
         g.taken = choice.member;  // members are the objects, in order
+        if (g.taken >= 0) {
+          // What XrGraspFingerStateSDFG reports: the contacts on the object taken, as the worker
+          // computes them (grasp_worker.cpp), checked against the grader's exact distance.
+          const size_t t = size_t(g.taken);
+          const FingerContacts contacts = computeContacts(hand, result, members[t].objectFromHand,
+                                                          objects[t].distance.get(), &grid);
+          for (int f = 0; f < kFingerCount; ++f) {
+            const FingerContact& c = contacts[size_t(f)];
+            if (!c.valid || choice.touched[size_t(f)] != g.taken) continue;
+            const glm::vec3 world = scene.objects[t].worldFromObject.transformPoint(c.center);
+            const double d = objects[t].exact->signedDistance(world);
+            g.v1ResidualMm = std::max(g.v1ResidualMm, float(1000.0 * std::abs(d - c.distance)));
+            ++g.v1Contacts;
+          }
+        }
       } else if (physics) {
         g.taken = physicsTaken(objects, scene, worldFromHand, result, palm);
       } else {
@@ -299,6 +339,12 @@ Result<SceneFigures> measureScene(const BenchScene& scene, const SceneRun& run) 
         if (mm > g.otherPenetrationMm) {
           g.otherPenetrationMm = mm;
           g.deepestObject = int(i);
+        }
+      }
+      if (openInside[p]) {
+        for (const Prepared& o : objects) {
+          g.wholeMm =
+              std::max(g.wholeMm, graspPenetrationMm(*o.exact, hand, worldFromHand, result));
         }
       }
       const size_t gradedObject = g.taken >= 0 ? size_t(g.taken) : scene.reachedFor;
@@ -323,7 +369,7 @@ Result<SceneFigures> measureScene(const BenchScene& scene, const SceneRun& run) 
   for (std::thread& th : pool) th.join();
 
   SceneFigures out;
-  std::vector<double> other;
+  std::vector<double> other, inside;
   QualityTally held;
   for (size_t p = 0; p < graded.size(); ++p) {
     const Graded& g = graded[p];
@@ -355,8 +401,28 @@ Result<SceneFigures> measureScene(const BenchScene& scene, const SceneRun& run) 
       }
     }
     held.add(int(p), g.metrics);
+    out.clearanceExceeded += g.exceeded ? 1 : 0;
+    out.v1Contacts += g.v1Contacts;
+    out.v1ResidualMaxMm = std::max(out.v1ResidualMaxMm, double(g.v1ResidualMm));
+    if (openInside[p]) {
+      ++out.openInside;
+      if (g.exceeded) {
+        const double deeper = double(g.wholeMm) - double(openMm[p]);
+        if (out.exceededDeeperPlacement < 0 || deeper > out.exceededDeeperMaxMm) {
+          out.exceededDeeperMaxMm = deeper;
+          out.exceededDeeperPlacement = int(p);
+        }
+      } else {
+        inside.push_back(g.wholeMm);
+        if (g.wholeMm > out.insideWholeMaxMm) {
+          out.insideWholeMaxMm = g.wholeMm;
+          out.insideDeepestPlacement = int(p);
+        }
+      }
+    }
   }
   out.otherPenetrationP99Mm = percentile(other, 0.99);
+  if (!inside.empty()) out.insideWholeP99Mm = percentile(inside, 0.99);
   out.held = held.figures();
   return out;
 }

@@ -48,6 +48,9 @@ struct SceneRun {
   SolverOptions options{};
   bool exactCheck = true;  // "ours": the scene's exact distance (GraspSettings::exactCheck)
   GridBox box = GridBox::referenceDefault();
+  // Approaching hands (eval/approaching.h): the palm from 1 cm inside to 5 cm outside the object
+  // reached for, open hands inside it kept (those inside another object are drawn again).
+  bool approaching = false;
 };
 
 struct SceneFigures {
@@ -72,6 +75,22 @@ struct SceneFigures {
   // Single-object figures on the object held (else the one reached for): fingers touching it,
   // contact residuals, fingers into it (per grasp's deepest), early stops, pass-throughs.
   QualityFigures held;
+  // With SceneRun::approaching: the grasps whose open hand started inside the object reached for.
+  // Of those the clearance moved (within its bound), the whole hand's deepest penetration into
+  // any object after the grasp (the one held too: out of it without going into a neighbour). The
+  // others (the hand needed more than the bound, and says so) are left where they were: their
+  // fingers must not close any deeper than the open hand already was.
+  int openInside = 0;
+  double insideWholeP99Mm = 0.0;
+  double insideWholeMaxMm = 0.0;
+  int insideDeepestPlacement = -1;
+  int clearanceExceeded = 0;         // grasps whose hand needed more than the clearance's bound
+  double exceededDeeperMaxMm = 0.0;  // of those: after minus before, the most (<= 0: never deeper)
+  int exceededDeeperPlacement = -1;
+  // "ours": the version 1 contacts an app reads (XrGraspFingerStateSDFG, the fingers on the object
+  // taken): the engine's distance against the grader's exact signed distance at the same point.
+  int v1Contacts = 0;
+  double v1ResidualMaxMm = 0.0;
 };
 
 // Errors: an unknown strategy, invalid options, fewer placements found than asked, or a failed

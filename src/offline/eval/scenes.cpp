@@ -17,8 +17,10 @@ constexpr glm::vec3 kTableHalf{0.25f, 0.02f, 0.25f};
 constexpr float kMugHalfHeight = 0.0475f;
 constexpr float kMugRadius = 0.04f;
 constexpr float kMugHandleReach = 0.0735f;
-constexpr float kMugGap = 0.005f;   // between the two mugs
-constexpr float kWallGap = 0.015f;  // from the handle's end to the wall
+constexpr float kMugGap = 0.005f;                  // between the two mugs
+constexpr float kMugNearGap = 0.01f;               // between the two mugs of "mug-near-mug"
+constexpr glm::vec3 kRuler{0.15f, 0.003f, 0.03f};  // a ruler's length, thickness, width
+constexpr float kWallGap = 0.015f;                 // from the handle's end to the wall
 constexpr float kWallHalfThickness = 0.01f;
 
 SceneObject boxObject(const std::string& name, const glm::vec3& half, const glm::vec3& centre) {
@@ -61,18 +63,37 @@ BenchScene tableScene(const std::string& name, const TriangleMesh& mesh) {
   return scene;
 }
 
+// Two mugs `gap` apart on the table, the second turned half a turn (its body ends at
+// x = centre + radius, its handle away), the hand reaching for the first.
+BenchScene mugBesideMug(const std::string& name, float gap, const std::string& description) {
+  BenchScene s;
+  s.name = name;
+  s.description = description;
+  s.objects.push_back(mugAt("mug", glm::vec3(0.0f), 0.0f));
+  const float centre = -kMugRadius - gap - kMugRadius;
+  s.objects.push_back(mugAt("mug-2", glm::vec3(centre, 0.0f, 0.0f), std::numbers::pi_v<float>));
+  s.objects.push_back(makeTable());
+  return s;
+}
+
 std::vector<BenchScene> objectScenes() {
   std::vector<BenchScene> scenes;
+  scenes.push_back(mugBesideMug(
+      "mug-beside-mug", kMugGap,
+      "two mugs 5 mm apart on a table, both graspable (the second turned, handle away); the "
+      "hand reaches for the first"));
+  scenes.push_back(mugBesideMug("mug-near-mug", kMugNearGap,
+                                "two mugs 1 cm apart on a table, as mug-beside-mug"));
   {
+    // Thin and narrower than a hand: fingers that close past its edges land on the table.
     BenchScene s;
-    s.name = "mug-beside-mug";
-    s.description =
-        "two mugs 5 mm apart on a table, both graspable (the second turned, handle away); the "
-        "hand reaches for the first";
-    s.objects.push_back(mugAt("mug", glm::vec3(0.0f), 0.0f));
-    // Turned half a turn, the second mug's body ends at x = centre + radius.
-    const float centre = -kMugRadius - kMugGap - kMugRadius;
-    s.objects.push_back(mugAt("mug-2", glm::vec3(centre, 0.0f, 0.0f), std::numbers::pi_v<float>));
+    s.name = "ruler-on-table";
+    s.description = "a ruler (15 x 3 cm, 3 mm thick) lying flat on a table";
+    SceneObject ruler;
+    ruler.name = "ruler";
+    ruler.mesh = makeBox(kRuler);
+    ruler.worldFromObject.position = glm::vec3(0.0f, 0.5f * kRuler.y, 0.0f);
+    s.objects.push_back(std::move(ruler));
     s.objects.push_back(makeTable());
     scenes.push_back(std::move(s));
   }

@@ -42,7 +42,8 @@ BenchScene tableScene(const std::string& name, const TriangleMesh& mesh);
 
 // The scenes of objects among objects, all of them at real size on the table:
 //  - "mug-beside-mug": two mugs 5 mm apart (the second turned so its handle points away), both
-//    graspable, the hand reaching for the first;
+//    graspable, the hand reaching for the first; "mug-near-mug": the same 1 cm apart;
+//  - "ruler-on-table": a ruler (15 x 3 cm, 3 mm thick) lying flat, graspable;
 //  - "spoon-in-mug": a spoon (makeSpoon) standing slanted in a mug, touching neither, both
 //    graspable, the hand reaching for the spoon (only its handle, above the rim, has room);
 //  - "mug-handle-wall": a mug whose handle ends 1.5 cm from a wall (scene geometry, 2 cm thick).

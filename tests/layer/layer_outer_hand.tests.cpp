@@ -287,3 +287,56 @@ TEST_CASE("Outer hand: the configuration key and the options switch turn it off"
     CHECK(depthIn(shown.back().joints, table) <= 0.001f);
   }
 }
+
+TEST_CASE("Outer hand: a table rising into a still open hand pushes it out of its way",
+          "[layer][outer_hand]") {
+  // The world moves, not the hand (smooth locomotion down a slope, a lift, an object brought to
+  // the hand): the app moves the table 3.3 mm a frame (0.3 m/s at 90 Hz) toward the palm, from
+  // 3 mm under it to 4.6 cm past where the hand is, then holds it there.
+  const Slab start = slabUnderPalm({0.3f, 0.02f, 0.3f});
+  const glm::vec3 up = -openRightHand(kGrip).down;
+  XrEnv env;
+  env.handTracking = "absent";
+  env.script = gripLine(0, "right", kGrip) + squeezeLine(0, "right", 0.0f);
+  applyEnv(env);
+  App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}});
+  REQUIRE(app.ok());
+  Ext ext(app);
+  const XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
+  const XrGraspTargetSDFG table =
+      makeShapeTarget(app, ext, XR_GRASP_SHAPE_TYPE_BOX_SDFG, start.half, start.pose,
+                      XR_GRASP_TARGET_ROLE_SCENE_SDFG);
+  REQUIRE(app.framesUntil([&] { return app.framesEnded >= 3; }));
+  Slab now = start;
+  float deepest = -1.0f;
+  auto next = std::chrono::steady_clock::now();
+  Joints joints;
+  for (int k = 0; k < 30; ++k) {
+    next += std::chrono::microseconds(11111);
+    std::this_thread::sleep_until(next);
+    if (k < 15) {
+      now.pose = shifted(start.pose, up * (0.0033f * float(k + 1)));
+      XrGraspTargetPlacementSDFG p{XR_TYPE_GRASP_TARGET_PLACEMENT_SDFG, nullptr, app.local,
+                                   now.pose};
+      REQUIRE(ext.place(table, &p) == XR_SUCCESS);
+    }
+    XrResult located = XR_ERROR_RUNTIME_FAILURE;
+    app.frame([&] { located = locateJoints(app, tracker, joints); });
+    REQUIRE(located == XR_SUCCESS);
+    deepest = std::max(deepest, depthIn(joints, now));
+  }
+  // While it moves, the hand is drawn from the answer to the frame before at worst (the worker
+  // answers after the app located its hand): one frame of the table's motion, 3.3 mm.
+  CHECK(deepest <= 0.004f);
+  // Once it stops, the hand is out of it (waited for: the worker may answer late).
+  bool out = false;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!out && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::microseconds(11111));
+    app.frame([&] {
+      out = locateJoints(app, tracker, joints) == XR_SUCCESS && depthIn(joints, now) <= 0.001f;
+    });
+  }
+  CHECK(out);
+  CHECK(validationLog().empty());
+}

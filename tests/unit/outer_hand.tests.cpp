@@ -272,3 +272,45 @@ TEST_CASE("A curled hand swiped at 2 m/s into a 3 mm plate stays on its side",
     CHECK(farthest < 0.0f);
   }
 }
+
+TEST_CASE("A target that moves into a still hand pushes the shown hand out of its way",
+          "[core][outer_hand]") {
+  // The world moves, not the hand: a table top rising into it (locomotion down a slope, a lift),
+  // and a box brought to it sideways (an object handed over), 3.3 mm a frame (0.3 m/s at 90 Hz).
+  TestHand h;
+  const float touchHeight = -h.lowest();
+  const glm::vec3 wrist(0.0f, touchHeight + 0.01f, 0.0f);  // 1 cm above where it touches y = 0
+  const AnalyticShape table{ShapeKind::box, glm::vec3(0.5f, 0.02f, 0.5f)};
+  const AnalyticShape box{ShapeKind::box, glm::vec3(0.03f, 0.03f, 0.03f)};
+  const bool rising = GENERATE(true, false);
+  CAPTURE(rising);
+  const AnalyticShape& shape = rising ? table : box;
+  OuterHand outer(h.model);
+  float deepest = 0.0f;
+  OuterHandResult r;
+  bool pushed = false;
+  for (int frame = 0; frame < 30; ++frame) {
+    const float travel = 0.0033f * float(frame);
+    // The table's top from 1 cm under the hand to 9 cm into it; the box from 12 cm beside the
+    // palm (along +x) to 2 cm past it.
+    const Pose worldFromShape = rising ? at(glm::vec3(0.0f, -0.02f + travel, 0.0f))
+                                       : at(glm::vec3(0.12f - travel, touchHeight - 0.02f, 0.0f));
+    const std::vector<SceneMember> members{{1, nullptr, &shape, worldFromShape.inverse()}};
+    const SceneExactSource scene(members);
+    OuterHandInput in;
+    in.worldFromWrist = at(wrist);
+    in.joints = &h.joints;
+    in.radii = &h.radii;
+    in.time = frame * kFrame;
+    in.sceneMoved = true;  // as the worker says when a member's pose changed
+    const auto result = outer.update(in, &scene);
+    REQUIRE(result.ok());
+    r = *result;
+    pushed = pushed || r.pushedOut;
+    deepest = std::min(deepest, shownClearance(h, r, shape, worldFromShape));
+  }
+  CHECK(pushed);
+  CHECK(r.constrained);
+  // Never inside by more than the exact search's tolerance, in any frame.
+  CHECK(deepest >= -0.001f);
+}

@@ -280,6 +280,8 @@ class GraspWorker {
     uint64_t sampledTarget = 0;
     uint64_t sampledVersion = 0;
     std::vector<HandPart> samples;
+    // The members of the last job run (target, objectFromHand): whether the scene moved since.
+    std::vector<std::pair<uint64_t, Pose>> lastScene;
   };
   struct Slot {
     std::optional<Job> queued;

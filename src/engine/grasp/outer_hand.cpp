@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
+#include <span>
 
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
@@ -269,6 +271,30 @@ Pose slide(const RigidParts& parts, const glm::vec3& pivotLocal, const Pose& fro
   return pose;
 }
 
+// The smallest rigid motion (world) that clears the hand's parts (world centres and radii) when
+// some of them are inside: nothing when none is, or when none within releaseDistance clears
+// them (caught deep, or between two objects: left where it is, the release takes it).
+std::optional<Pose> pushOut(std::span<const glm::vec3> world, std::span<const float> radii,
+                            const glm::vec3& pivot, const ExactDistanceSource& source,
+                            const OuterHandOptions& o, int& samples) {
+  Probe probe(source);
+  probe.reset(world.size());
+  const float lowest = probe(world, radii, o.margin + kActiveBand, kInf);
+  samples += probe.samples;
+  if (lowest >= 0.0f) return std::nullopt;
+  HandParts parts;
+  const size_t n = std::min(world.size(), parts.size());
+  for (size_t i = 0; i < n; ++i) parts[i] = HandPart{world[i], radii[i], radii[i], Joint::palm};
+  ClearanceOptions co;
+  co.margin = o.margin;
+  co.maxCorrection = o.releaseDistance;
+  auto cleared = clearHand(std::span<const HandPart>(parts.data(), n), pivot, nullptr, &source, co);
+  if (!cleared) return std::nullopt;
+  samples += cleared->exactSamples;
+  if (cleared->exceeded || !cleared->wasInside) return std::nullopt;
+  return cleared->handCorrection;
+}
+
 }  // namespace
 
 std::vector<HandPart> surfaceParts(const TriangleMesh& mesh) {
@@ -359,6 +385,8 @@ void OuterHand::setModel(const HandModel& model) {
 }
 
 void OuterHand::reset() {
+  shownRigid_.clear();
+  shownRigidRadius_.clear();
   engaged_ = false;
   released_ = false;
   blending_ = false;
@@ -459,6 +487,13 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
   }
   const glm::vec3 pivot = (*in.joints)[size_t(Joint::palm)].position;
   const FingerCurls user = model_.estimateCurls(*in.joints);
+  // The hand's own rigid parts shown last frame (for a target that moved into it), and this
+  // frame's for the next.
+  const ptrdiff_t handRigid = ptrdiff_t(rigid.local.size() - in.attached.size());
+  std::vector<glm::vec3> lastRigid(rigid.local.begin(), rigid.local.begin() + handRigid);
+  std::vector<float> lastRigidRadius(rigid.radius.begin(), rigid.radius.begin() + handRigid);
+  std::swap(lastRigid, shownRigid_);
+  std::swap(lastRigidRadius, shownRigidRadius_);
 
   if (!engaged_) {
     engaged_ = true;
@@ -566,8 +601,24 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
     return out;
   }
 
-  // A hand held still against a surface stays where it is shown (no jitter).
+  // The rigid part inside where it was shown: a target moved into the hand (an object brought to
+  // it, the world moved past the user, the other hand's held object), so no motion of the hand
+  // put it there. Out first, by the smallest rigid motion (hand_clearance.h), then on toward
+  // tracking. (A finger a target moved into is the finger stage's: it curls out of it.)
   int slideSamples = 0;
+  // The hand tested is the one shown last (its rigid parts then), in the world as it is now: a
+  // part the user's own input moves in (a thumb curled into the table) is not the world's doing.
+  if (in.sceneMoved && !lastRigid.empty()) {
+    std::vector<glm::vec3> handWorld;
+    for (const glm::vec3& p : lastRigid) handWorld.push_back(shown_.transformPoint(p));
+    if (auto c = pushOut(handWorld, lastRigidRadius, shown_.transformPoint(pivot), *scene, options_,
+                         slideSamples)) {
+      shown_ = *c * shown_;
+      out.pushedOut = true;
+    }
+  }
+
+  // A hand held still against a surface stays where it is shown (no jitter).
   Pose next = shown_;
   if (!(wasConstrained && motion(tracked, lastTracked_) <= options_.stillness)) {
     // The rigid part, with every finger as it was shown (clear there) joining the constraints.

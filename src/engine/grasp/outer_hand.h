@@ -64,6 +64,9 @@ struct OuterHandInput {
   // Fingers that close on a grasp (the grasp's solve, clear of the whole scene): moved with the
   // rigid part as given, never re-curled, so they stay on what they hold.
   std::array<bool, kFingerCount> rigidFingers{};
+  // A target of `scene` moved (or appeared) since the last update: the hand shown then is tested
+  // against the scene now, and moved out of what moved into it.
+  bool sceneMoved = false;
 };
 
 struct OuterHandResult {
@@ -76,6 +79,7 @@ struct OuterHandResult {
   bool touching = false;     // some part is on a surface (within margin + 0.5 mm)
   bool blending = false;     // returning to tracking past releaseDistance
   bool released = false;     // following tracking until the tracked hand is clear again
+  bool pushedOut = false;    // a target had moved into the hand shown last: moved out of it
   // A lower bound of the shown hand's smallest part clearance, metres (inf: nothing near; for a
   // free hand searched to 2.5 cm, so at most that).
   float clearance = 0.0f;
@@ -126,6 +130,10 @@ class OuterHand {
   Pose lastTracked_;
   std::array<bool, kFingerCount> capped_{};
   std::array<float, kFingerCount> curl_{};  // last shown curl per finger
+  // The hand's own rigid parts (wrist frame) in the last update: what a target that moves into
+  // the hand is tested against, at shown_ (empty: no update since the last reset).
+  std::vector<glm::vec3> shownRigid_;
+  std::vector<float> shownRigidRadius_;
   bool released_ = false;
   bool blending_ = false;
   double blendStart_ = 0.0;

@@ -238,6 +238,7 @@ void updateHands(SessionState& s, const Gathered& g, UpdateReport& report) {
     HandFrame frame;
     frame.squeeze = g.squeeze[h];
     frame.time = s.predictedTime;
+    frame.graspOffset = shownHandOffset(s.offsets.hands[h]);
     if (g.trackedValid[h]) {
       frame.valid = true;
       frame.worldFromWrist = g.joints[h][size_t(Joint::wrist)];

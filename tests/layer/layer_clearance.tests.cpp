@@ -6,6 +6,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <string>
 
 #include <glm/gtc/quaternion.hpp>
@@ -57,7 +58,15 @@ void read(App& app, const Ext& ext, XrHandTrackerEXT tracker, Reading& r) {
 // offset has blended in), and checks the hand ends clear, moved by the reported offset, blended
 // both ways. Frames run until each outcome, with a time bound: the layer solves on its session's
 // worker, so how many frames a grasp takes depends on the machine.
-void grabFromInside(const TestMesh& mesh, const XrPosef& pose, const XrPosef& grip) {
+// With `neighbour` (a second object, registered too): the hand starts clear of it and ends clear
+// of both (the clearance moves it out of the one it grabs without moving it into the other).
+struct Neighbour {
+  TestMesh mesh;
+  XrPosef pose;
+};
+
+void grabFromInside(const TestMesh& mesh, const XrPosef& pose, const XrPosef& grip,
+                    const Neighbour* neighbour = nullptr) {
   XrEnv env;
   env.handTracking = "absent";
   env.script =
@@ -70,6 +79,12 @@ void grabFromInside(const TestMesh& mesh, const XrPosef& pose, const XrPosef& gr
   makeTarget(app, ext, mesh, pose);
   const ExactDistance exact(mesh, pose);
   const auto distance = [&](const XrVector3f& p) { return exact(p); };
+  std::unique_ptr<ExactDistance> other;
+  if (neighbour != nullptr) {
+    makeTarget(app, ext, neighbour->mesh, neighbour->pose);
+    other = std::make_unique<ExactDistance>(neighbour->mesh, neighbour->pose);
+  }
+  const auto otherDistance = [&](const XrVector3f& p) { return (*other)(p); };
 
   // The open hand, before the grab, is partly inside the object.
   Reading r;
@@ -77,6 +92,7 @@ void grabFromInside(const TestMesh& mesh, const XrPosef& pose, const XrPosef& gr
   read(app, ext, tracker, r);
   REQUIRE(r.state.isGrasping == XR_FALSE);
   REQUIRE(wholeHandClearance(r.joints, distance) < -0.003f);
+  if (other) REQUIRE(wholeHandClearance(r.joints, otherDistance) > 0.0f);
 
   // Held, with the offset blended in fully: polled, not a fixed frame count.
   bool partial = false;
@@ -100,6 +116,7 @@ void grabFromInside(const TestMesh& mesh, const XrPosef& pose, const XrPosef& gr
   CHECK(glm::length(wrist.position - (hand.wrist * offset).position) < 1e-4f);
   // Every part of the hand is clear of the object (within the exact check's tolerance).
   CHECK(wholeHandClearance(r.joints, distance) > -5e-4f);
+  if (other) CHECK(wholeHandClearance(r.joints, otherDistance) > -5e-4f);
   int contacts = 0;
   for (const XrGraspFingerStateSDFG& f : r.state.fingers) contacts += f.inContact ? 1 : 0;
   CHECK(contacts >= 2);
@@ -135,7 +152,18 @@ TEST_CASE("A palm squeezed inside the mug's wall is moved out before the fingers
   const glm::vec3 y = glm::normalize(hand.across - glm::dot(hand.across, x) * x);
   const glm::quat q = glm::quat_cast(glm::mat3(x, y, glm::cross(x, y)));
   const glm::vec3 c = hand.palm + hand.down * (0.015f + 0.04f - 0.01f);
-  grabFromInside(toTestMesh(sdfg::makeMug()), {{q.x, q.y, q.z, q.w}, {c.x, c.y, c.z}}, grip);
+  const TestMesh mug = toTestMesh(sdfg::makeMug());
+  const XrPosef pose{{q.x, q.y, q.z, q.w}, {c.x, c.y, c.z}};
+  SECTION("alone") {
+    grabFromInside(mug, pose, grip);
+  }
+  SECTION("a second mug 1 cm from it, beside the palm") {
+    // Along the palm's side (the mugs' bodies are 8 cm across): the hand's way out is beside it.
+    const glm::vec3 side = glm::cross(x, y);
+    const glm::vec3 c2 = c + side * (0.08f + 0.01f);
+    const Neighbour second{mug, {{q.x, q.y, q.z, q.w}, {c2.x, c2.y, c2.z}}};
+    grabFromInside(mug, pose, grip, &second);
+  }
 }
 
 TEST_CASE("A palm squeezed through the thin plate is moved out before the fingers close",

@@ -112,6 +112,9 @@ struct HandFrame {
   // The caller's time stamp of this frame (the layer: the predicted display time the poses were
   // located at), handed back as HandGrasp::time of the solves made from it.
   int64_t time = 0;
+  // The grasp's offset the hand is drawn with (wrist frame; grasp/hand_offset_blend.h, as of the
+  // caller's last frame): the outer hand keeps the hand out where it is drawn.
+  Pose graspOffset{};
 };
 
 // A target located in its own right this frame (the older form of update(): each target is

@@ -143,6 +143,7 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
   job.time = double(frame.time) * 1e-9;
   job.model = view.model;
   job.rigidFingers = rigidFingers;
+  job.drawnOffset = frame.graspOffset;
   job.options = settings_.outerOptions;
   const Pose worldFromShown = frame.worldFromWrist * view.fallback.offset;
   if (held != 0) {

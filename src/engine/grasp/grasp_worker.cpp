@@ -365,15 +365,17 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
     in.time = job.time;
     in.attached = parts;
     in.rigidFingers = job.rigidFingers;
-    // A target that moved (or came) since the last job may now be in the hand shown then.
+    in.drawnOffset = job.drawnOffset;
+    // A target that moved since the last job may now be in the hand shown then. (One that only
+    // came within reach did not: the hand's own motion brought it.)
     std::vector<std::pair<uint64_t, Pose>> now;
     for (const SceneMember& m : scene) now.emplace_back(m.id, m.objectFromHand);
-    in.sceneMoved =
-        now.size() != o.lastScene.size() ||
-        !std::equal(now.begin(), now.end(), o.lastScene.begin(), [](const auto& a, const auto& b) {
-          return a.first == b.first && a.second.position == b.second.position &&
-                 a.second.orientation == b.second.orientation;
-        });
+    in.sceneMoved = std::any_of(now.begin(), now.end(), [&](const auto& m) {
+      return std::any_of(o.lastScene.begin(), o.lastScene.end(), [&](const auto& was) {
+        return was.first == m.first && (was.second.position != m.second.position ||
+                                        was.second.orientation != m.second.orientation);
+      });
+    });
     o.lastScene = std::move(now);
     const SceneExactSource source(scene);
     auto r = o.hand->update(in, scene.empty() ? nullptr : &source);

@@ -175,6 +175,7 @@ class GraspWorker {
     uint64_t attached = 0;
     Pose wristFromAttached;
     std::array<bool, kFingerCount> rigidFingers{};  // OuterHandInput::rigidFingers
+    Pose drawnOffset{};                             // OuterHandInput::drawnOffset
     HandModel model = HandModel::defaultAdult(Hand::right);
     OuterHandOptions options{};
   };

@@ -444,13 +444,15 @@ void OuterHand::fingerSpheres(int f, float a, std::vector<glm::vec3>& out) const
   for (size_t i = 0; i < rig.t.size(); ++i) {
     const int bone = std::min(int(rig.t[i]), int(joints.size()) - 2);
     const float u = rig.t[i] - float(bone);
-    out[i] = glm::mix(poses[size_t(bone)].position, poses[size_t(bone) + 1].position, u);
+    out[i] = drawnOffset_.transformPoint(
+        glm::mix(poses[size_t(bone)].position, poses[size_t(bone) + 1].position, u));
   }
 }
 
 Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
                                           const ExactDistanceSource* scene) {
-  if (in.joints == nullptr || in.radii == nullptr || !finitePose(in.worldFromWrist))
+  if (in.joints == nullptr || in.radii == nullptr || !finitePose(in.worldFromWrist) ||
+      !finitePose(in.drawnOffset))
     return makeError(Status::invalid_argument, "outer hand: joints, radii and a finite wrist");
   if (auto e = options_.validate()) return *e;
   const Pose& tracked = in.worldFromWrist;
@@ -462,9 +464,13 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
     return out;
   }
 
-  // The hand as given, in parts (wrist frame): the rigid ones, and each finger's.
+  // The hand as given, in parts (wrist frame): the rigid ones, and each finger's; moved by the
+  // grasp's offset where it is drawn.
+  drawnOffset_ = in.drawnOffset;
+  JointPoses drawn;
+  for (int j = 0; j < kJointCount; ++j) drawn[size_t(j)] = in.drawnOffset * (*in.joints)[size_t(j)];
   HandParts parts;
-  const int count = jointParts(*in.joints, *in.radii, parts);
+  const int count = jointParts(drawn, *in.radii, parts);
   RigidParts rigid;
   std::array<std::vector<glm::vec3>, kFingerCount> fingerLocal;
   std::array<std::vector<float>, kFingerCount> fingerRadius;
@@ -485,7 +491,7 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
     rigid.local.push_back(p.centre);
     rigid.radius.push_back(p.coverRadius + attachedRadius);
   }
-  const glm::vec3 pivot = (*in.joints)[size_t(Joint::palm)].position;
+  const glm::vec3 pivot = drawn[size_t(Joint::palm)].position;
   const FingerCurls user = model_.estimateCurls(*in.joints);
   // The hand's own rigid parts shown last frame (for a target that moved into it), and this
   // frame's for the next.

@@ -64,9 +64,12 @@ struct OuterHandInput {
   // Fingers that close on a grasp (the grasp's solve, clear of the whole scene): moved with the
   // rigid part as given, never re-curled, so they stay on what they hold.
   std::array<bool, kFingerCount> rigidFingers{};
-  // A target of `scene` moved (or appeared) since the last update: the hand shown then is tested
-  // against the scene now, and moved out of what moved into it.
+  // A target of `scene` moved since the last update: the hand shown then is tested against the
+  // scene now, and moved out of what moved into it.
   bool sceneMoved = false;
+  // The grasp's offset the hand is drawn with (wrist frame; grasp/hand_offset_blend.h), after the
+  // outer hand's own: every part, capped fingers too, is kept out where it is drawn.
+  Pose drawnOffset{};
 };
 
 struct OuterHandResult {
@@ -123,6 +126,7 @@ class OuterHand {
 
   HandModel model_;
   OuterHandOptions options_;
+  Pose drawnOffset_{};  // OuterHandInput::drawnOffset of the update in progress
   std::array<FingerRig, kFingerCount> rigs_{};
 
   bool engaged_ = false;  // history exists

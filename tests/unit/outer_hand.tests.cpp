@@ -314,3 +314,47 @@ TEST_CASE("A target that moves into a still hand pushes the shown hand out of it
   // Never inside by more than the exact search's tolerance, in any frame.
   CHECK(deepest >= -0.001f);
 }
+
+TEST_CASE("A tracked hand that jumps is shown at its new pose at once, or the nearest clear one",
+          "[core][outer_hand]") {
+  // Pressed 3 cm into a table (shown on it), then tracking jumps 50 cm: onto a clear pose, or onto
+  // one 1 cm into a box standing there. Never blended through what lies between.
+  TestHand h;
+  const float touchHeight = -h.lowest();
+  const AnalyticShape table{ShapeKind::box, glm::vec3(0.5f, 0.02f, 0.5f)};
+  const Pose worldFromTable = at(glm::vec3(0.0f, -0.02f, 0.0f));
+  const AnalyticShape box{ShapeKind::box, glm::vec3(0.05f, 0.05f, 0.05f)};
+  // The box's top 1 cm above where the hand at x = 0.5 m touches y = 0.
+  const Pose worldFromBox = at(glm::vec3(0.5f, -0.04f, 0.0f));
+  const std::vector<SceneMember> members{{1, nullptr, &table, worldFromTable.inverse()},
+                                         {2, nullptr, &box, worldFromBox.inverse()}};
+  const SceneExactSource scene(members);
+  OuterHand outer(h.model);
+  double t = 0.0;
+  auto step = [&](const glm::vec3& wrist) {
+    OuterHandInput in;
+    in.worldFromWrist = at(wrist);
+    in.joints = &h.joints;
+    in.radii = &h.radii;
+    in.time = (t += kFrame);
+    const auto r = outer.update(in, &scene);
+    REQUIRE(r.ok());
+    return *r;
+  };
+  for (int k = 0; k <= 5; ++k) step(glm::vec3(0.0f, touchHeight + 0.01f - 0.008f * k, 0.0f));
+  REQUIRE(step(glm::vec3(0.0f, touchHeight - 0.03f, 0.0f)).constrained);
+  const bool intoBox = GENERATE(false, true);
+  CAPTURE(intoBox);
+  const glm::vec3 landing(-0.5f, touchHeight + 0.05f, 0.0f);
+  const glm::vec3 inBox(0.5f, touchHeight - 0.0f, 0.0f);  // 1 cm into the box's top
+  const OuterHandResult r = step(intoBox ? inBox : landing);
+  CHECK_FALSE(r.blending);
+  if (!intoBox) {
+    CHECK_FALSE(r.constrained);
+    CHECK(r.worldFromShownWrist.position == landing);
+  } else {
+    CHECK(r.pushedOut);
+    CHECK(shownClearance(h, r, box, worldFromBox) >= -0.001f);
+    CHECK(glm::length(r.worldFromShownWrist.position - inBox) < 0.02f);  // the nearest way out
+  }
+}

@@ -87,8 +87,18 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
   outerMembers(frame.worldFromWrist.transformPoint(palm), kOuterReach, held, members);
   const std::shared_ptr<const GraspWorker::OuterDone> latest =
       outer.engaged ? worker_->outerMailbox(slot)->latest.load() : nullptr;
-  const bool fresh =
+  bool fresh =
       latest != nullptr && latest->ticket > outer.resetTicket && latest->status == Status::ok;
+  // The tracked hand jumped since that result (outer_hand.h, kJumpDistance): the result is of
+  // another place; the hand is shown where it is now until the worker's answer for it.
+  if (fresh) {
+    float moved = 0.0f;
+    for (int j = 0; j < kJointCount; ++j)
+      moved = std::max(moved,
+                       glm::length(frame.worldFromWrist.transformPoint(local[size_t(j)].position) -
+                                   latest->trackedJoints[size_t(j)]));
+    if (moved > kJumpDistance) fresh = false;
+  }
   if (fresh)
     outerMembers(latest->result.worldFromShownWrist.transformPoint(palm), kOuterReach, held,
                  members);

@@ -276,11 +276,12 @@ Pose slide(const RigidParts& parts, const glm::vec3& pivotLocal, const Pose& fro
 // them (caught deep, or between two objects: left where it is, the release takes it).
 std::optional<Pose> pushOut(std::span<const glm::vec3> world, std::span<const float> radii,
                             const glm::vec3& pivot, const ExactDistanceSource& source,
-                            const OuterHandOptions& o, int& samples) {
+                            const OuterHandOptions& o, int& samples, bool* inside = nullptr) {
   Probe probe(source);
   probe.reset(world.size());
   const float lowest = probe(world, radii, o.margin + kActiveBand, kInf);
   samples += probe.samples;
+  if (inside != nullptr) *inside = lowest < 0.0f;
   if (lowest >= 0.0f) return std::nullopt;
   HandParts parts;
   const size_t n = std::min(world.size(), parts.size());
@@ -501,14 +502,6 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
   std::swap(lastRigid, shownRigid_);
   std::swap(lastRigidRadius, shownRigidRadius_);
 
-  if (!engaged_) {
-    engaged_ = true;
-    shown_ = tracked;
-    lastTracked_ = tracked;
-    for (int f = 0; f < kFingerCount; ++f) curl_[size_t(f)] = user[size_t(f)];
-    capped_.fill(false);
-  }
-
   // The largest motion of any part between two wrist poses.
   auto motion = [&](const Pose& a, const Pose& b) {
     float m = 0.0f;
@@ -518,6 +511,42 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
     }
     return m;
   };
+
+  // A hand that jumps (farther than a hand moves between two updates: tracking lost and found
+  // elsewhere, or the app teleported it) is shown at its new pose at once, never blended there
+  // through whatever lies between; where that pose is inside something, at the nearest pose that
+  // is clear (within releaseDistance; deeper, it follows tracking until it is clear, as after a
+  // release).
+  int arrivalSamples = 0;
+  const bool jumped = engaged_ && motion(lastTracked_, tracked) > kJumpDistance;
+  if (!engaged_ || jumped) {
+    engaged_ = true;
+    shown_ = tracked;
+    lastTracked_ = tracked;
+    blending_ = false;
+    released_ = false;
+    for (int f = 0; f < kFingerCount; ++f) curl_[size_t(f)] = user[size_t(f)];
+    capped_.fill(false);
+    // A hand that appears inside (its first update) is left to the grasp's clearance, which moves
+    // the open hand out at a grab, and to the release rule; a jump is the outer hand's.
+    if (jumped) {
+      std::vector<glm::vec3> handWorld;
+      std::vector<float> handRadii;
+      for (int i = 0; i < count; ++i) {
+        handWorld.push_back(tracked.transformPoint(parts[size_t(i)].centre));
+        handRadii.push_back(parts[size_t(i)].coverRadius);
+      }
+      bool inside = false;
+      if (auto c = pushOut(handWorld, handRadii, tracked.transformPoint(pivot), *scene, options_,
+                           arrivalSamples, &inside)) {
+        shown_ = *c * tracked;
+        out.pushedOut = true;
+      } else if (inside) {
+        released_ = true;  // no clear pose within the bound: tracking, until it is clear
+      }
+    }
+    lastRigid.clear();  // nothing shown before to test against the scene
+  }
   Probe probe(*scene);
   std::vector<glm::vec3> world;
   std::vector<float> radii;
@@ -753,7 +782,7 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
                     std::any_of(capped_.begin(), capped_.end(), [](bool c) { return c; });
   out.clearance = handClearance(shown_, options_.margin + kActiveBand);
   out.touching = out.clearance <= options_.margin + 0.0005f;
-  out.samples = probe.samples + fingerProbe.samples + slideSamples;
+  out.samples = probe.samples + fingerProbe.samples + slideSamples + arrivalSamples;
   return out;
 }
 

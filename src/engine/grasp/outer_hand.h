@@ -38,6 +38,10 @@
 
 namespace sdfg {
 
+// Farther than a hand moves between two updates (3 m/s at 30 Hz is 10 cm), metres of largest
+// part motion: the tracked hand jumped (tracking lost and found elsewhere, or teleported).
+inline constexpr float kJumpDistance = 0.2f;
+
 struct OuterHandOptions {
   float margin = 0.0005f;         // clearance every part keeps, metres
   float releaseDistance = 0.10f;  // metres of largest part motion between shown and tracked

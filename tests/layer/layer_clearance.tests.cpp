@@ -88,6 +88,10 @@ void grabFromInside(const TestMesh& mesh, const XrPosef& pose, const XrPosef& gr
 
   // The open hand, before the grab, is partly inside the object.
   Reading r;
+  // Both set up before the squeeze: a grab while the neighbour's set-up is still running solves
+  // without it, and when it comes in the held hand was seen to end 10 mm inside the grabbed mug
+  // (about 1 in 4 runs beside two busy loops; not solved yet, issue 37's closing note).
+  REQUIRE(untilSetUp(app, ext, [&](const auto& s) { return s.readyCount >= (other ? 2u : 1u); }));
   app.frames(2);
   read(app, ext, tracker, r);
   REQUIRE(r.state.isGrasping == XR_FALSE);

@@ -325,9 +325,11 @@ TEST_CASE("Outer hand: a table rising into a still open hand pushes it out of it
     REQUIRE(located == XR_SUCCESS);
     deepest = std::max(deepest, depthIn(joints, now));
   }
-  // While it moves, the hand is drawn from the answer to the frame before at worst (the worker
-  // answers after the app located its hand): one frame of the table's motion, 3.3 mm.
-  CHECK(deepest <= 0.004f);
+  // While it moves, the hand is drawn from the worker's last answer: on time, the answer to the
+  // frame before (one frame of the table's motion, 3.3 mm); a loaded machine or a sanitizer
+  // answers a frame or two later still (5.4 mm seen under ThreadSanitizer). Without the push the
+  // hand stays where it was and ends 38 mm in.
+  CHECK(deepest <= 0.010f);
   // Once it stops, the hand is out of it (waited for: the worker may answer late).
   bool out = false;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);

@@ -70,6 +70,24 @@ float shownClearance(const TestHand& h, const OuterHandResult& r, const Analytic
   return lowest;
 }
 
+// One update a frame (90 Hz) of `outer` for the still-shaped hand `h` with its wrist at `wrist`.
+struct Stepper {
+  OuterHand& outer;
+  const TestHand& h;
+  const SceneExactSource& scene;
+  double t = 0.0;
+  OuterHandResult operator()(const glm::vec3& wrist) {
+    OuterHandInput in;
+    in.worldFromWrist = at(wrist);
+    in.joints = &h.joints;
+    in.radii = &h.radii;
+    in.time = (t += kFrame);
+    const auto r = outer.update(in, &scene);
+    REQUIRE(r.ok());
+    return *r;
+  }
+};
+
 }  // namespace
 
 TEST_CASE("The outer hand is the tracked hand while nothing is near", "[core][outer_hand]") {
@@ -104,17 +122,11 @@ TEST_CASE("A hand pushed into a table stops on it, slides along it and comes bac
   const float touchHeight = -h.lowest();  // wrist height at which the hand just touches y = 0
   float deepest = 0.0f, worstJitter = 0.0f;
   Pose last;
-  double t = 0.0;
+  Stepper next{outer, h, scene};
   auto step = [&](const glm::vec3& wrist) {
-    OuterHandInput in;
-    in.worldFromWrist = at(wrist);
-    in.joints = &h.joints;
-    in.radii = &h.radii;
-    in.time = (t += kFrame);
-    const auto r = outer.update(in, &scene);
-    REQUIRE(r.ok());
-    deepest = std::min(deepest, shownClearance(h, *r, table, worldFromTable));
-    return *r;
+    const OuterHandResult r = next(wrist);
+    deepest = std::min(deepest, shownClearance(h, r, table, worldFromTable));
+    return r;
   };
   // Down from 5 cm above the touch to 4 cm below it, 1 cm per frame (0.9 m/s).
   OuterHandResult r;
@@ -330,17 +342,7 @@ TEST_CASE("A tracked hand that jumps is shown at its new pose at once, or the ne
                                          {2, nullptr, &box, worldFromBox.inverse()}};
   const SceneExactSource scene(members);
   OuterHand outer(h.model);
-  double t = 0.0;
-  auto step = [&](const glm::vec3& wrist) {
-    OuterHandInput in;
-    in.worldFromWrist = at(wrist);
-    in.joints = &h.joints;
-    in.radii = &h.radii;
-    in.time = (t += kFrame);
-    const auto r = outer.update(in, &scene);
-    REQUIRE(r.ok());
-    return *r;
-  };
+  Stepper step{outer, h, scene};
   for (int k = 0; k <= 5; ++k) step(glm::vec3(0.0f, touchHeight + 0.01f - 0.008f * k, 0.0f));
   REQUIRE(step(glm::vec3(0.0f, touchHeight - 0.03f, 0.0f)).constrained);
   const bool intoBox = GENERATE(false, true);

@@ -68,10 +68,6 @@ struct Neighbour {
 void grabFromInside(const TestMesh& mesh, const XrPosef& pose, const XrPosef& grip,
                     const Neighbour* neighbour = nullptr) {
   XrEnv env;
-  // With a neighbour, the grasp's clearance alone: the outer hand, which the neighbour engages,
-  // and a grasp's correction are not yet drawn consistently while both move the hand (issue 36's
-  // closing note: about 1 grab in 6 under ThreadSanitizer ended 10 mm inside the grabbed mug).
-  if (neighbour != nullptr) env.extra = {{"SDFG_AUTOGRASP_OUTER_HAND", "off"}};
   env.handTracking = "absent";
   env.script =
       gripLine(0, "right", grip) + squeezeLine(0, "right", 0.0f) + squeezeLine(6, "right", 1.0f);

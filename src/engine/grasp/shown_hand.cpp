@@ -55,7 +55,9 @@ void drawTrackedHand(const ShownHand& view, JointPoses& joints,
       for (Joint j : fingerJoints(static_cast<Finger>(f))) changed[size_t(j)] = true;
     }
   }
-  if (outer.changes) capFingers(view.outer.model, outer, baseFromWrist, joints);
+  // A shown grasp's fingers are the solve's, clear of the scene (the outer hand moves them with
+  // the hand): a result that capped fingers before the grasp was shown must not re-curl them.
+  if (outer.changes && !view.shown) capFingers(view.outer.model, outer, baseFromWrist, joints);
   // The whole hand moves out of the object, every joint (wrist and palm too).
   if (view.offsetShown) applyHandOffset(view.offset, joints);
   if (whole) changed.fill(true);
@@ -75,7 +77,7 @@ void drawGripHand(const ShownHand& view, const Pose& baseFromGrip, MotionRange r
     const ShownCurls c = shownCurls(view.result, user, view.closing);
     replaceFingers(view.model, c.curls, c.replace, baseFromWrist, joints);
   }
-  if (outer.changes) capFingers(view.outer.model, outer, baseFromWrist, joints);
+  if (outer.changes && !view.shown) capFingers(view.outer.model, outer, baseFromWrist, joints);
   if (view.offsetShown) applyHandOffset(view.offset, joints);
 }
 

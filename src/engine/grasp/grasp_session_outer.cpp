@@ -93,15 +93,18 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
       outer.engaged ? worker_->outerMailbox(slot)->latest.load() : nullptr;
   bool fresh =
       latest != nullptr && latest->ticket > outer.resetTicket && latest->status == Status::ok;
-  // The tracked hand jumped since that result (outer_hand.h, kJumpDistance): the result is of
-  // another place; the hand is shown where it is now until the worker's answer for it.
+  // How far any part of the hand moved since that result (a joint's radius growth counted). A
+  // jump (outer_hand.h, kJumpDistance) makes it a result of another place: the hand is shown
+  // where it is now until the worker's answer for it.
+  float sinceResult = 0.0f;
   if (fresh) {
-    float moved = 0.0f;
-    for (int j = 0; j < kJointCount; ++j)
-      moved = std::max(moved,
-                       glm::length(frame.worldFromWrist.transformPoint(local[size_t(j)].position) -
-                                   latest->trackedJoints[size_t(j)]));
-    if (moved > kJumpDistance) fresh = false;
+    for (int j = 0; j < kJointCount; ++j) {
+      const glm::vec3 now = frame.worldFromWrist.transformPoint(shown[size_t(j)].position);
+      sinceResult =
+          std::max(sinceResult, glm::length(now - latest->trackedJoints[size_t(j)]) +
+                                    std::max(0.0f, radii[size_t(j)] - latest->radii[size_t(j)]));
+    }
+    if (sinceResult > kJumpDistance) fresh = false;
   }
   if (fresh)
     outerMembers(latest->result.worldFromShownWrist.transformPoint(palm), kOuterReach, held,
@@ -126,12 +129,7 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
     const OuterHandResult& r = latest->result;
     bool clear = !r.constrained;
     if (clear) {
-      float motion = 0.0f;
-      for (int j = 0; j < kJointCount; ++j) {
-        const glm::vec3 now = frame.worldFromWrist.transformPoint(shown[size_t(j)].position);
-        motion = std::max(motion, glm::length(now - latest->trackedJoints[size_t(j)]) +
-                                      std::max(0.0f, radii[size_t(j)] - latest->radii[size_t(j)]));
-      }
+      float motion = sinceResult;
       if (held != 0) {
         const Pose turn = latest->trackedWrist.inverse() * frame.worldFromWrist;
         motion = std::max(

@@ -73,15 +73,9 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
                 local, radii);
   }
   JointPoses shown = local;
-  std::array<bool, kFingerCount> rigidFingers{};
   if (hand.grasp.shown()) {
     const ShownCurls c = shownCurls(hand.grasp.result, hand.model.estimateCurls(local));
     replaceFingers(hand.model, c.curls, c.replace, Pose{}, shown);
-    // Every finger of a shown grasp is the solve's: clear of the whole scene from open to its
-    // contact curl (the solver closed it along that path), so the outer hand moves them all with
-    // the hand and re-curls none. (A finger it capped was capped against the grasp's offset of
-    // an earlier frame, and drawn with today's: seen 2-10 mm inside what the hand held.)
-    rigidFingers.fill(true);
   }
 
   // What is near: around the tracked palm and the last shown one.
@@ -154,7 +148,11 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
   job.radii = radii;
   job.time = double(frame.time) * 1e-9;
   job.model = view.model;
-  job.rigidFingers = rigidFingers;
+  // Every finger of a shown grasp is the solve's: clear of the whole scene from open to its
+  // contact curl (the solver closed it along that path), so the outer hand moves them all with
+  // the hand and re-curls none. (A finger it capped was capped against the grasp's offset of an
+  // earlier frame, and drawn with today's: seen 2-10 mm inside what the hand held.)
+  job.rigidFingers = hand.grasp.shown();
   job.drawnOffset = frame.graspOffset;
   job.options = settings_.outerOptions;
   const Pose worldFromShown = frame.worldFromWrist * view.fallback.offset;

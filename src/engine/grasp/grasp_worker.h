@@ -174,8 +174,8 @@ class GraspWorker {
     // surface is sampled here, once per target and vertex version.
     uint64_t attached = 0;
     Pose wristFromAttached;
-    std::array<bool, kFingerCount> rigidFingers{};  // OuterHandInput::rigidFingers
-    Pose drawnOffset{};                             // OuterHandInput::drawnOffset
+    bool rigidFingers = false;  // OuterHandInput::rigidFingers
+    Pose drawnOffset{};         // OuterHandInput::drawnOffset
     HandModel model = HandModel::defaultAdult(Hand::right);
     OuterHandOptions options{};
   };

@@ -478,7 +478,7 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
   for (int i = 0; i < count; ++i) {
     const HandPart& p = parts[size_t(i)];
     const int f = fingerOf(p.joint);
-    if (f < 0 || isMetacarpal(p.joint) || in.rigidFingers[size_t(f)]) {
+    if (f < 0 || isMetacarpal(p.joint) || in.rigidFingers) {
       rigid.local.push_back(p.centre);
       rigid.radius.push_back(p.coverRadius);
     } else {
@@ -693,7 +693,7 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
   Probe fingerProbe(*scene);
   std::vector<float> drop;
   for (int f = 0; f < kFingerCount; ++f) {
-    if (in.rigidFingers[size_t(f)]) {
+    if (in.rigidFingers) {
       curl_[size_t(f)] = user[size_t(f)];
       capped_[size_t(f)] = false;
       continue;

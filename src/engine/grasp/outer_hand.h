@@ -65,9 +65,9 @@ struct OuterHandInput {
   // caller leaves the held object itself out of `scene`). They may rest on a surface (a held
   // object lying on a table where the app put it does not push the hand off it) but not enter it.
   std::span<const HandPart> attached{};
-  // Fingers that close on a grasp (the grasp's solve, clear of the whole scene): moved with the
-  // rigid part as given, never re-curled, so they stay on what they hold.
-  std::array<bool, kFingerCount> rigidFingers{};
+  // The fingers are a grasp's (its solve, clear of the whole scene from open to contact): moved
+  // with the rigid part as given, never re-curled, so they stay on what they hold.
+  bool rigidFingers = false;
   // A target of `scene` moved since the last update: the hand shown then is tested against the
   // scene now, and moved out of what moved into it.
   bool sceneMoved = false;

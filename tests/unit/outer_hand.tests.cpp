@@ -360,3 +360,34 @@ TEST_CASE("A tracked hand that jumps is shown at its new pose at once, or the ne
     CHECK(glm::length(r.worldFromShownWrist.position - inBox) < 0.02f);  // the nearest way out
   }
 }
+
+TEST_CASE("Bad input to the outer hand is refused and changes nothing", "[core][outer_hand]") {
+  TestHand h;
+  const AnalyticShape table{ShapeKind::box, glm::vec3(0.5f, 0.02f, 0.5f)};
+  const std::vector<SceneMember> members{
+      {1, nullptr, &table, at(glm::vec3(0.0f, -0.02f, 0.0f)).inverse()}};
+  const SceneExactSource scene(members);
+  const float touchHeight = -h.lowest();
+  OuterHand plain(h.model), refused(h.model);
+  Stepper good{plain, h, scene}, other{refused, h, scene};
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const int kind = GENERATE(0, 1, 2);  // null joints, a non-finite wrist, a non-finite offset
+  CAPTURE(kind);
+  for (int k = 0; k <= 8; ++k) {
+    const glm::vec3 wrist(0.0f, touchHeight + 0.01f - 0.005f * float(k), 0.0f);
+    OuterHandInput bad;
+    bad.worldFromWrist = at(wrist);
+    bad.joints = &h.joints;
+    bad.radii = &h.radii;
+    bad.time = other.t;
+    if (kind == 0) bad.joints = nullptr;
+    if (kind == 1) bad.worldFromWrist.position.x = nan;
+    if (kind == 2) bad.drawnOffset.orientation.w = nan;
+    const auto r = refused.update(bad, &scene);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().code == Status::invalid_argument);
+    const OuterHandResult a = good(wrist), b = other(wrist);
+    CHECK(a.worldFromShownWrist.position == b.worldFromShownWrist.position);
+    CHECK(a.constrained == b.constrained);
+  }
+}

@@ -10,8 +10,12 @@
 #   library_missing       the manifest names a library that does not exist
 #   no_runtime            XR_RUNTIME_JSON names no file
 #   usage                 an unknown option: exit 2
+#   incompatible_manifest the manifest's file_format_version is one the loader does not read
+#   library_unloadable    the manifest names a file that is no shared library
+#   incompatible_library  the library (REFUSING_LAYER) refuses the loader's negotiation
 # Usage: cmake -DDOCTOR=<exe> -DRUNTIME_JSON=<mock manifest> -DLAYER_JSON=<implicit manifest>
-#          -DDISABLE_ENV=<variable> -DWORK=<scratch dir> -DCASE=<case> -P doctor_test.cmake
+#          -DDISABLE_ENV=<variable> -DWORK=<scratch dir> -DCASE=<case>
+#          [-DREFUSING_LAYER=<library>] -P doctor_test.cmake
 cmake_minimum_required(VERSION 3.25)
 foreach(var DOCTOR RUNTIME_JSON LAYER_JSON DISABLE_ENV WORK CASE)
   if(NOT ${var})
@@ -72,6 +76,23 @@ elseif(CASE STREQUAL "no_runtime")
 elseif(CASE STREQUAL "usage")
   set(args --json --bogus)
   set(expect_rc 2)
+elseif(CASE MATCHES "^(incompatible_manifest|library_unloadable|incompatible_library)$")
+  # The layer's manifest, changed as the case says.
+  set(install_layer OFF)
+  set(expect_rc 1)
+  file(READ "${LAYER_JSON}" manifest)
+  if(CASE STREQUAL "incompatible_manifest")
+    string(JSON manifest SET "${manifest}" file_format_version "\"1.1.0\"")
+  elseif(CASE STREQUAL "library_unloadable")
+    file(WRITE "${WORK}/not-a-library.so" "an OpenXR layer, truncated by a failed copy\n")
+    string(JSON manifest SET "${manifest}" api_layer library_path "\"${WORK}/not-a-library.so\"")
+  else()
+    if(NOT REFUSING_LAYER)
+      message(FATAL_ERROR "pass -DREFUSING_LAYER=...")
+    endif()
+    string(JSON manifest SET "${manifest}" api_layer library_path "\"${REFUSING_LAYER}\"")
+  endif()
+  file(WRITE "${implicit}/XrApiLayer_sdfg_autograsp.json" "${manifest}")
 else()
   message(FATAL_ERROR "unknown CASE ${CASE}")
 endif()
@@ -193,5 +214,30 @@ elseif(CASE STREQUAL "library_missing")
 elseif(CASE STREQUAL "no_runtime")
   expect(no_runtime status)
   expect_match("no-such-runtime.json" reason)
+elseif(CASE STREQUAL "incompatible_manifest")
+  expect(incompatible status)
+  expect_match("file_format_version 1.1.0, which this loader does not read" reason)
+  expect(OFF layer manifests 0 enabled)
+  expect(OFF layer loaded)
+  expect_length(0 api_layers chain)
+  expect("" layer negotiation)
+elseif(CASE STREQUAL "library_unloadable")
+  expect(library_unloadable status)
+  expect_match("not-a-library.so cannot be loaded" reason)
+  expect(ON layer manifests 0 library_found)
+  expect(OFF layer negotiation opened)
+  expect(OFF layer loaded)
+elseif(CASE STREQUAL "incompatible_library")
+  expect(incompatible status)
+  expect_match("refuses the loader's negotiation \\(loader interface 1-1" reason)
+  expect_match("XR_ERROR_INITIALIZATION_FAILED" reason)
+  expect(ON layer negotiation opened)
+  expect(ON layer negotiation has_function)
+  expect(OFF layer negotiation accepted)
+  expect(OFF layer loaded)
+endif()
+if(CASE STREQUAL "live")
+  # A live layer is not probed: the loader's own negotiation succeeded.
+  expect("" layer negotiation)
 endif()
 message(STATUS "doctor ${CASE}: as expected")

@@ -47,11 +47,6 @@ std::string failure(const char* call, XrResult r) {
   return std::string(call) + " failed: " + resultName(r);
 }
 
-std::string versionText(uint64_t v) {
-  return std::to_string(XR_VERSION_MAJOR(v)) + "." + std::to_string(XR_VERSION_MINOR(v)) + "." +
-         std::to_string(XR_VERSION_PATCH(v));
-}
-
 std::vector<std::string> splitList(const std::string& text) {
   std::vector<std::string> out;
   size_t start = 0;
@@ -271,6 +266,9 @@ void explainAbsence(Report& report) {
     const LayerManifest& m = report.manifests.front();
     if (!m.problem.empty())
       set("broken_manifest", m.path + " " + m.problem + ", so the loader skips it");
+    else if (!m.incompatibility.empty())
+      set("incompatible", m.path + " " + m.incompatibility +
+                              ", so the loader skips it: install the layer built for this loader");
     else if (m.disabledByEnvironment)
       set("disabled",
           m.disableEnvironment + " is set (its manifest's disable_environment): unset it");
@@ -285,6 +283,27 @@ void explainAbsence(Report& report) {
         usable->path + " names " + usable->libraryResolved + ", which does not exist");
     return;
   }
+  const Negotiation& n = report.negotiation;
+  if (n.ran && !n.opened) {
+    set("library_unloadable",
+        n.library + " cannot be loaded (" + n.openError + "), so the loader skips it");
+    return;
+  }
+  if (n.ran && !n.hasFunction) {
+    set("incompatible", n.library + " exports no " + n.function +
+                            ": it is no OpenXR API layer library, so the loader skips it");
+    return;
+  }
+  if (n.ran && !n.accepted()) {
+    set("incompatible",
+        n.library + " refuses the loader's negotiation (loader interface " +
+            std::to_string(n.loaderMinInterface) + "-" + std::to_string(n.loaderMaxInterface) +
+            ", OpenXR " + versionText(n.loaderMinApi) + "-" + versionText(n.loaderMaxApi) + ": " +
+            (XR_FAILED(n.result) ? resultName(n.result) : "no xrGetInstanceProcAddr") +
+            "): it was built for another loader interface; install the layer built for this "
+            "loader");
+    return;
+  }
   if (!report.instanceError.empty()) {
     const bool noRuntime = !report.runtimeManifest.problem.empty() ||
                            report.instanceError.find("RUNTIME_UNAVAILABLE") != std::string::npos;
@@ -297,8 +316,13 @@ void explainAbsence(Report& report) {
             "; the layer cannot be checked without an instance");
     return;
   }
-  set("not_loaded", std::string("its manifest is enabled, but the instance has no ") +
-                        kLayerFunction + " of the layer (the loader did not load it)");
+  set("not_loaded",
+      std::string("its manifest is enabled, but the instance has no ") + kLayerFunction +
+          " of the layer (the loader did not load it" +
+          (n.ran ? ", though its library negotiates loader interface " +
+                       std::to_string(n.layerInterface) + " and OpenXR " + versionText(n.layerApi)
+                 : std::string()) +
+          ")");
 }
 
 void decideHands(Report& report, const std::optional<bool>& runtimeTracks,
@@ -488,6 +512,19 @@ Report examine(const Options& options) {
     report.systemName = system.name;
     report.systemError = system.error;
     if (!inChain && report.hands.runtimeOffers) runtimeTracks = system.hands;
+  }
+
+  // Left out by the loader although a manifest enables it: ask the library what the loader got.
+  // Asked also when xrCreateInstance failed: a loader that loads no layer at all fails the call
+  // with the layer's own error.
+  if (!report.loaded) {
+    for (const LayerManifest& m : report.manifests) {
+      if (!m.enabled() || (!m.libraryResolved.empty() && !m.libraryFound)) continue;
+      report.negotiation =
+          negotiateWithLayer(m.libraryResolved.empty() ? m.library : m.libraryResolved, kLayerName,
+                             m.negotiateFunction);
+      break;
+    }
   }
 
   if (report.loaded) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "manifests.h"
+#include "negotiation.h"
 
 namespace sdfg::doctor {
 
@@ -60,8 +61,8 @@ struct IgnoredSetting {
 };
 
 struct Report {
-  // The verdict. status: live, disabled, not_installed, broken_manifest, library_missing,
-  // not_loaded, no_runtime, no_loader.
+  // The verdict. status: live, disabled, not_installed, broken_manifest, incompatible,
+  // library_missing, library_unloadable, not_loaded, no_runtime, no_instance, no_loader.
   bool live = false;
   std::string status;
   std::string reason;
@@ -88,6 +89,8 @@ struct Report {
   std::string loadedFrom;                // the library they come from
   std::vector<Extension> layerExtensions;
   std::string disableEnvironment;
+  // The library's own answer to the loader's negotiation, asked when the loader left it out.
+  Negotiation negotiation;
 
   struct Hands {
     bool offered = false;               // XR_EXT_hand_tracking is offered to apps

@@ -1,8 +1,11 @@
 #include "manifests.h"
 
+#include <openxr/openxr.h>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+
+#include <cstdio>
 
 namespace sdfg::doctor {
 namespace {
@@ -76,6 +79,29 @@ LayerManifest readLayer(const ManifestSource& source, const std::string& path) {
     }
   }
   m.name = stringField(*layer, "name");
+  // The loader's two version checks (manifest_file.cpp): it reads file format 1.0.0 only, and
+  // api_version "major.minor" up to its own major version.
+  const std::string format = stringField(json, "file_format_version");
+  unsigned fmt[3] = {0, 0, 0};
+  if (std::sscanf(format.c_str(), "%u.%u.%u", &fmt[0], &fmt[1], &fmt[2]) != 3 || fmt[0] != 1 ||
+      fmt[1] != 0 || fmt[2] != 0)
+    m.incompatibility = "has file_format_version " + format +
+                        ", which this loader does not read (it reads 1.0.0 only)";
+  const std::string api = stringField(*layer, "api_version");
+  unsigned major = 0, minor = 0;
+  if (std::sscanf(api.c_str(), "%u.%u", &major, &minor) != 2 || (major == 0 && minor == 0)) {
+    m.problem = "has api_version '" + api + "', not major.minor";
+    return m;
+  }
+  if (m.incompatibility.empty() && major > XR_VERSION_MAJOR(XR_CURRENT_API_VERSION))
+    m.incompatibility = "has api_version " + api + ", for OpenXR " + std::to_string(major) +
+                        ", newer than this loader's OpenXR " +
+                        std::to_string(XR_VERSION_MAJOR(XR_CURRENT_API_VERSION));
+  if (const auto functions = layer->find("functions");
+      functions != layer->end() && functions->is_object()) {
+    const std::string renamed = stringField(*functions, "xrNegotiateLoaderApiLayerInterface");
+    if (!renamed.empty()) m.negotiateFunction = renamed;
+  }
   m.library = stringField(*layer, "library_path");
   resolveLibrary(path, m.library, m.libraryResolved, m.libraryFound);
   if (!hasStringField(*layer, "disable_environment")) {

@@ -14,6 +14,9 @@ struct LayerManifest {
   std::string path;     // the manifest file
   std::string origin;   // why the loader reads it (ManifestSource::origin)
   std::string problem;  // why the loader would skip it as malformed; empty when it is well formed
+  // Why the loader would skip it as made for another loader (file_format_version other than
+  // 1.0.0, api_version of a newer OpenXR major version); empty when this loader reads it.
+  std::string incompatibility;
   std::string name;
   std::string library;          // library_path as written
   std::string libraryResolved;  // with a relative path resolved against the manifest's folder
@@ -23,11 +26,13 @@ struct LayerManifest {
   std::string enableEnvironment;       // optional: the layer is on only while this is set
   bool missingEnableEnvironment = false;
   bool disabledInRegistry = false;  // Windows: the registry value's data is not 0
+  // The library's negotiation function, as the manifest's "functions" object may rename it.
+  std::string negotiateFunction = "xrNegotiateLoaderApiLayerInterface";
 
   // Whether the loader puts it in every instance's chain.
   bool enabled() const {
-    return problem.empty() && !disabledByEnvironment && !missingEnableEnvironment &&
-           !disabledInRegistry;
+    return problem.empty() && incompatibility.empty() && !disabledByEnvironment &&
+           !missingEnableEnvironment && !disabledInRegistry;
   }
 };
 

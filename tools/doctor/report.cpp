@@ -21,6 +21,7 @@ Json manifestJson(const LayerManifest& m) {
   return Json{{"path", m.path},
               {"origin", m.origin},
               {"problem", textOrNull(m.problem)},
+              {"incompatibility", textOrNull(m.incompatibility)},
               {"name", textOrNull(m.name)},
               {"library_path", textOrNull(m.library)},
               {"library", textOrNull(m.libraryResolved)},
@@ -31,6 +32,21 @@ Json manifestJson(const LayerManifest& m) {
               {"missing_enable_environment", m.missingEnableEnvironment},
               {"disabled_in_registry", m.disabledInRegistry},
               {"enabled", m.enabled()}};
+}
+
+// The library's answer to the loader's negotiation; null when it was not asked.
+Json negotiationJson(const Negotiation& n) {
+  if (!n.ran) return nullptr;
+  return Json{{"library", n.library},
+              {"function", n.function},
+              {"opened", n.opened},
+              {"open_error", textOrNull(n.openError)},
+              {"has_function", n.hasFunction},
+              {"accepted", n.accepted()},
+              {"loader_interface", {n.loaderMinInterface, n.loaderMaxInterface}},
+              {"loader_api", {versionText(n.loaderMinApi), versionText(n.loaderMaxApi)}},
+              {"layer_interface", n.accepted() ? Json(n.layerInterface) : Json(nullptr)},
+              {"layer_api", n.accepted() ? Json(versionText(n.layerApi)) : Json(nullptr)}};
 }
 
 const char* vulkanPathText(const std::string& path) {
@@ -115,12 +131,27 @@ std::string reportText(const Report& report) {
   for (const LayerManifest& m : report.manifests) {
     out << label("  manifest") << m.path << " (" << m.origin << ")";
     if (!m.problem.empty()) out << ": " << m.problem;
+    if (!m.incompatibility.empty()) out << ": " << m.incompatibility;
     out << "\n";
     if (!m.libraryResolved.empty())
       out << label("  library") << m.libraryResolved << (m.libraryFound ? "" : " (MISSING)")
           << "\n";
     else if (!m.library.empty())
       out << label("  library") << m.library << " (found by the system's library search)\n";
+  }
+  if (const Negotiation& n = report.negotiation; n.ran) {
+    out << label("  negotiation");
+    if (!n.opened)
+      out << "the library cannot be loaded: " << n.openError << "\n";
+    else if (!n.hasFunction)
+      out << "the library exports no " << n.function << "\n";
+    else if (!n.accepted())
+      out << "refused: loader interface " << n.loaderMinInterface << "-" << n.loaderMaxInterface
+          << ", OpenXR " << versionText(n.loaderMinApi) << "-" << versionText(n.loaderMaxApi)
+          << "\n";
+    else
+      out << "accepted: loader interface " << n.layerInterface << ", OpenXR "
+          << versionText(n.layerApi) << "\n";
   }
   out << label("  switch") << report.disableEnvironment;
   bool disabled = false;
@@ -211,6 +242,7 @@ std::string reportJson(const Report& report) {
                    {"disable_environment", report.disableEnvironment},
                    {"disabled_by_environment", disabled},
                    {"manifests", manifests},
+                   {"negotiation", negotiationJson(report.negotiation)},
                    {"extensions", extensions}};
 
   const Report::Hands& h = report.hands;

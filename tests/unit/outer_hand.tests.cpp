@@ -391,3 +391,50 @@ TEST_CASE("Bad input to the outer hand is refused and changes nothing", "[core][
     CHECK(a.constrained == b.constrained);
   }
 }
+
+TEST_CASE("After a release the shown hand never follows tracking into another object",
+          "[core][outer_hand]") {
+  TestHand h;
+  // A thick table (top at y = 0) and a comb standing on it: a box 2 cm thick in x, 8 cm tall.
+  const AnalyticShape table{ShapeKind::box, glm::vec3(0.5f, 0.1f, 0.5f)};
+  const Pose worldFromTable = at(glm::vec3(0.0f, -0.1f, 0.0f));
+  const AnalyticShape comb{ShapeKind::box, glm::vec3(0.01f, 0.04f, 0.2f)};
+  const Pose worldFromComb = at(glm::vec3(0.16f, 0.04f, 0.0f));
+  const std::vector<SceneMember> members{{1, nullptr, &table, worldFromTable.inverse()},
+                                         {2, nullptr, &comb, worldFromComb.inverse()}};
+  const SceneExactSource scene(members);
+  OuterHand outer(h.model);
+  Stepper next{outer, h, scene};
+  const float touch = -h.lowest();
+  // Pushed 15 cm into the table, 1 cm a frame: let go past the release distance, blended to
+  // tracking, then shown as tracked inside.
+  OuterHandResult r;
+  for (int k = 0; k <= 17; ++k) r = next(glm::vec3(0.0f, touch + 0.02f - 0.01f * float(k), 0.0f));
+  for (int k = 0; k < 40; ++k) r = next(glm::vec3(0.0f, touch - 0.15f, 0.0f));
+  REQUIRE(r.released);
+  // Up until the hand is half out (its lower part still in the table), then along +x into the
+  // comb, 1 cm a frame, to 4 cm past where the hand's side meets its near face (x = 0.15).
+  const float halfOut = touch - 0.01f;
+  for (float y = touch - 0.15f; y < halfOut; y += 0.01f) r = next(glm::vec3(0.0f, y, 0.0f));
+  r = next(glm::vec3(0.0f, halfOut, 0.0f));
+  CHECK(shownClearance(h, r, table, worldFromTable) < -0.002f);  // partly in the table
+  // The wrist's x where the hand's side (its largest x in the wrist frame) touches the comb.
+  HandParts parts;
+  const int n = jointParts(h.joints, h.radii, parts);
+  float side = -1.0f;
+  for (int i = 0; i < n; ++i)
+    side = std::max(side, parts[size_t(i)].centre.x + parts[size_t(i)].radius);
+  const float meets = 0.15f - side;
+  float deepestInComb = 0.0f, trackedX = 0.0f;
+  for (int k = 1; 0.01f * float(k) <= meets + 0.04f; ++k) {
+    trackedX = 0.01f * float(k);
+    r = next(glm::vec3(trackedX, halfOut, 0.0f));
+    deepestInComb = std::min(deepestInComb, shownClearance(h, r, comb, worldFromComb));
+  }
+  // The tracked hand went 4 cm into the comb (followed there while released, the shown hand
+  // was 18.6 mm inside it); the shown hand stopped on it (it may turn along it) and is held again.
+  CHECK(deepestInComb >= -0.001f);
+  CHECK_FALSE(r.released);
+  CHECK(r.constrained);
+  CHECK(r.worldFromShownWrist.position.x < trackedX - 0.005f);
+}

@@ -14,7 +14,10 @@
 //   shown at the model's pose at that curl; a finger that touches nothing is shown as given.
 // - Release: when the tracked hand is more than releaseDistance from the shown one (largest part
 //   motion), the shown hand returns to tracking, blended over blendTime, as the Ultraleap and
-//   SteamVR hands do; it re-engages once the tracked hand is clear again.
+//   SteamVR hands do; it re-engages once the tracked hand is clear again, or as soon as a part
+//   that is clear where the hand is shown would follow tracking onto a surface (a hand let go
+//   inside a table and moved on into a comb stops on the comb; its parts still in the table are
+//   free to come out).
 // - While the straight motion from the last shown pose to the tracked one is free by more than the
 //   motion itself (nothing near), the shown hand is the tracked hand, exactly.
 //

@@ -197,6 +197,44 @@ TEST_CASE("Session outer hand: a hand pushed into a table is drawn on it, slides
   CHECK(sameJoints(drawn, rig.tracked(at(glm::vec3(0.1f, touch + 0.05f, 0.0f)))));
 }
 
+TEST_CASE("Session outer hand: while the worker is late, fingers close no further than it allowed",
+          "[core][outer_hand]") {
+  Rig rig;
+  rig.addShape(1, kTable, kWorldFromTable);
+  const float touch = touchHeight(rig);
+  // The open hand pressed 1 cm into the table: drawn on it, fingers flat on the surface.
+  JointPoses drawn;
+  for (int k = 0; k <= 4; ++k)
+    drawn = rig.frame(at(glm::vec3(0.0f, touch + 0.03f - 0.01f * float(k), 0.0f)));
+  REQUIRE(depthIn(drawn, rig.radii, kTable, kWorldFromTable) <= 0.001f);
+  // The worker answers nothing now; paced at 90 Hz, the frames are drawn from the fallback while
+  // the user closes the hand halfway (the fingertips curl down into the table).
+  rig.session.holdWorker(true);
+  rig.paced = true;
+  rig.next = std::chrono::steady_clock::now();
+  float deepest = -1.0f, deepestAsGiven = -1.0f;
+  for (int k = 1; k <= 10; ++k) {
+    FingerCurls curls;
+    curls.fill(0.05f * float(k));
+    placeJoints(rig.model, curls, Pose{}, rig.local, rig.radii);
+    const Pose wrist = at(glm::vec3(0.0f, touch - 0.01f, 0.0f));
+    drawn = rig.frame(wrist);
+    deepest = std::max(deepest, depthIn(drawn, rig.radii, kTable, kWorldFromTable));
+    // The same fingers as given on the hand where it is drawn: how deep they would go.
+    JointPoses asGiven;
+    const Pose drawnWrist = drawn[size_t(Joint::wrist)];
+    for (int j = 0; j < kJointCount; ++j) asGiven[size_t(j)] = drawnWrist * rig.local[size_t(j)];
+    deepestAsGiven = std::max(deepestAsGiven, depthIn(asGiven, rig.radii, kTable, kWorldFromTable));
+  }
+  rig.session.holdWorker(false);
+  CHECK(deepestAsGiven > 0.005f);  // the closing fingers would have gone into the table
+  CHECK(deepest <= 0.001f);
+  // The worker back: the fingers close onto the table as it answers (no part inside).
+  rig.paced = false;
+  drawn = rig.frame(at(glm::vec3(0.0f, touch - 0.01f, 0.0f)));
+  CHECK(depthIn(drawn, rig.radii, kTable, kWorldFromTable) <= 0.001f);
+}
+
 TEST_CASE("Session outer hand: paced at 90 Hz and drawn at once, the hand stays out of the table",
           "[core][outer_hand]") {
   // Drawn right after each update, before or after the worker's result: either way clear (the

@@ -14,6 +14,7 @@
 #include "grasp/grasp_session.h"
 #include "grasp/grasp_worker.h"
 #include "grasp/solver.h"
+#include "hand/hand_synthesis.h"
 #include "io/shapes.h"
 #include "mesh/mesh_distance.h"
 #include "sdf/sdf_backend.h"
@@ -507,4 +508,40 @@ TEST_CASE("New vertices that collapse a triangle are refused on the worker, once
   CHECK(session.takeRefusedUpdates().empty());
   applyAndWait(collapsed);
   CHECK(session.takeRefusedUpdates().size() == 1);
+}
+
+TEST_CASE("An outer-hand job runs before set-ups queued ahead of it", "[grasp_worker][core]") {
+  // Held, the worker starts nothing: three mesh set-ups are queued, then one frame's outer job
+  // for a hand resting on a table top. Let go, the outer job runs first: it waits for no set-up.
+  GraspWorker worker(makeCpuSdfBackend(1));
+  worker.hold(true);
+  const AnalyticShape table{ShapeKind::box, glm::vec3(0.5f, 0.02f, 0.5f)};
+  worker.addShape(1, table);
+  for (uint64_t id = 2; id <= 4; ++id) worker.addTarget(id, makeTorus());
+  GraspWorker::OuterJob job;
+  job.ticket = 1;
+  GraspWorker::JobMember member;
+  member.target = 1;
+  member.objectFromHand = Pose{glm::quat(1, 0, 0, 0), glm::vec3(0.0f, 0.02f, 0.0f)};
+  job.members.push_back(member);
+  job.worldFromWrist = Pose{glm::quat(1, 0, 0, 0), glm::vec3(0.0f, 0.05f, 0.0f)};
+  const HandModel model = HandModel::defaultAdult(Hand::right);
+  JointRadii radii{};
+  placeJoints(model, FingerCurls{}, Pose{}, job.joints, radii);
+  job.radii = radii;
+  job.model = model;
+  worker.requestOuter(0, std::move(job));
+  // Held: nothing runs, so waiting for idle times out.
+  CHECK_FALSE(worker.waitIdle(std::chrono::milliseconds(50)));
+  CHECK(worker.setupsDone() == 0);
+  CHECK(worker.outerMailbox(0)->latest.load() == nullptr);
+  worker.hold(false);
+  REQUIRE(worker.waitIdle(std::chrono::seconds(60)));
+  const auto done = worker.outerMailbox(0)->latest.load();
+  REQUIRE(done != nullptr);
+  CHECK(done->ticket == 1);
+  CHECK(done->status == Status::ok);
+  CHECK(done->setupsBefore == 0);
+  CHECK(worker.setupsDone() == 3);
+  for (uint64_t id = 2; id <= 4; ++id) CHECK(worker.targetInfo(id).setup == TargetSetup::ready);
 }

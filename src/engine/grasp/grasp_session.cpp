@@ -119,6 +119,10 @@ bool GraspSession::waitWorkerIdle(std::chrono::milliseconds timeout) const {
   return worker_->waitIdle(timeout);
 }
 
+void GraspSession::holdWorker(bool held) {
+  worker_->hold(held);
+}
+
 void GraspSession::refreshSetups() {
   // Only the targets still being set up: a room of a thousand ready targets costs nothing here.
   size_t kept = 0;

@@ -199,6 +199,9 @@ class GraspSession {
   // Waits until the worker has nothing queued or running, at most `timeout` (tests and tools
   // only; false on timeout).
   bool waitWorkerIdle(std::chrono::milliseconds timeout) const;
+  // Holds the worker (GraspWorker::hold): tests and tools that show what a hand gets while the
+  // worker's answer is late. The layer never holds it.
+  void holdWorker(bool held);
   // A target whose mesh exists only in the deferred backend (registered there under `id`, e.g.
   // the app's Vulkan buffers). `bounds` (target frame) must contain the mesh at all times; it
   // decides whether the target is in a grab box. Errors: invalid_argument (id in use, bad

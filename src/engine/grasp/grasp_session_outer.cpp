@@ -14,6 +14,10 @@ namespace {
 // are kept out: a hand reaches about 0.2 m from its palm, and moves 2.2 cm in a frame at 2 m/s.
 constexpr float kOuterReach = 0.15f;  // metres, half the box's edge
 
+// A finger the fallback shows as given may be this much more closed than the last result's curl
+// (the curl estimate's own noise on a tracked hand held still).
+constexpr float kCurlSlack = 0.01f;
+
 float angleOf(const glm::quat& q) {
   return 2.0f * std::acos(std::min(1.0f, std::abs(q.w)));
 }
@@ -137,6 +141,17 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
       view.fallback.capped = r.capped;
       view.fallback.curl = r.curl;
       view.fallback.changes = true;
+      // Fingers no further closed than that result left them: a finger the user closes more
+      // while the answer is late could close into what the hand rests on (a grasp's fingers are
+      // the solve's, and that result moved them as given).
+      if (!hand.grasp.shown()) {
+        const FingerCurls now = view.model.estimateCurls(shown);
+        for (int f = 0; f < kFingerCount; ++f) {
+          if (view.fallback.capped[size_t(f)] || now[size_t(f)] <= r.curl[size_t(f)] + kCurlSlack)
+            continue;
+          view.fallback.capped[size_t(f)] = true;
+        }
+      }
     }
   }
 

@@ -164,6 +164,14 @@ std::optional<GraspWorker::Done> GraspWorker::take(size_t slot) {
   return out;
 }
 
+void GraspWorker::hold(bool held) {
+  {
+    std::lock_guard lock(mutex_);
+    held_ = held;
+  }
+  wake_.notify_all();
+}
+
 bool GraspWorker::waitIdle(std::chrono::milliseconds timeout) const {
   std::unique_lock lock(mutex_);
   return idle_.wait_for(lock, timeout, [&] { return !busy_ && !anyQueued(); });
@@ -229,21 +237,16 @@ void GraspWorker::run() {
 #endif
   std::unique_lock lock(mutex_);
   for (;;) {
-    wake_.wait(lock, [&] { return stop_ || anyQueued(); });
+    wake_.wait(lock, [&] { return stop_ || (!held_ && anyQueued()); });
     if (stop_) break;
     busy_ = true;
-    if (!setups_.empty()) {
-      // Set-ups first: a target must be ready before any hand can grab it.
-      const uint64_t id = setups_.front();
-      setups_.pop_front();
-      auto it = targets_.find(id);
-      if (it != targets_.end() && it->second->setupMesh) runSetup(lock, id, it->second);
-    } else if ((outer_[0].queued || outer_[1].queued) &&
-               !(lastRanOuter_ && (slots_[0].queued || slots_[1].queued))) {
-      // The outer hand next: one frame's short solve, which the hand shows at once, before a
-      // build of a grab (milliseconds) that the hand waits frames for anyway. Outer jobs come
-      // every frame: after one, a queued grab runs before the next, so a worker slower than the
-      // frames cannot starve the grab.
+    const bool otherWork = !setups_.empty() || slots_[0].queued || slots_[1].queued;
+    if ((outer_[0].queued || outer_[1].queued) && !(lastRanOuter_ && otherWork)) {
+      // The outer hand first: one frame's short solve, which the hand shows at once, before a
+      // set-up or a build of a grab (milliseconds, up to seconds for a big mesh) that the hand
+      // waits frames for anyway. Outer jobs come every frame: after one, a queued set-up or grab
+      // runs before the next, so a worker slower than the frames starves neither. An outer job
+      // waits at most for the job in progress and the other hand's outer job.
       size_t slot = nextOuter_;
       if (!outer_[slot].queued) slot = 1 - slot;
       nextOuter_ = 1 - slot;
@@ -251,6 +254,13 @@ void GraspWorker::run() {
       OuterJob job = std::move(*outer_[slot].queued);
       outer_[slot].queued.reset();
       runOuter(lock, slot, std::move(job));
+    } else if (!setups_.empty()) {
+      // Set-ups before grabs: a target must be ready before any hand can grab it.
+      lastRanOuter_ = false;
+      const uint64_t id = setups_.front();
+      setups_.pop_front();
+      auto it = targets_.find(id);
+      if (it != targets_.end() && it->second->setupMesh) runSetup(lock, id, it->second);
     } else {
       // The slots take turns, so one hand's stream of re-solves cannot starve the other's grab.
       size_t slot = nextSlot_;
@@ -325,9 +335,11 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
       attachedVersion = attached->appliedVersion;
     }
   }
+  const uint64_t setupsBefore = setupsDone_;
   lock.unlock();
   auto done = std::make_shared<OuterDone>();
   done->ticket = job.ticket;
+  done->setupsBefore = setupsBefore;
   done->trackedWrist = job.worldFromWrist;
   for (int j = 0; j < kJointCount; ++j) {
     done->trackedJoints[size_t(j)] =

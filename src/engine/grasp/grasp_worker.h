@@ -189,6 +189,9 @@ class GraspWorker {
     std::array<glm::vec3, kJointCount> trackedJoints{};
     std::array<float, kJointCount> radii{};
     float attachedReach = 0.0f;
+    // Set-ups the worker had finished when it started the job (cumulative, as setupsDone()):
+    // shows that a queued set-up did not delay it.
+    uint64_t setupsBefore = 0;
   };
   // The newest finished outer-hand result of a slot, published by the worker and read from any
   // thread without waiting for the worker's work (the layer's xrLocateHandJointsEXT draws with a
@@ -243,8 +246,13 @@ class GraspWorker {
   // owner ignores it.
   void resetOuter(size_t slot);
 
-  // Waits until nothing is queued or running, at most `timeout`; false on timeout. For tests and
-  // tools: the layer never waits for the worker.
+  // While held, the worker starts no job (the one running finishes); queued jobs wait, newer
+  // ones replace them as usual. For tests and tools that need a late worker (what a hand shows
+  // while the worker's answer has not come) or a known order of jobs; the layer never holds it.
+  void hold(bool held);
+
+  // Waits until nothing is queued or running, at most `timeout`; false on timeout (always while
+  // held with work queued). For tests and tools: the layer never waits for the worker.
   bool waitIdle(std::chrono::milliseconds timeout) const;
   // Set-ups and hand jobs finished so far (cumulative).
   uint64_t setupsDone() const;
@@ -354,6 +362,7 @@ class GraspWorker {
   size_t nextOuter_ = 0;       // the outer slots take turns too
   bool lastRanOuter_ = false;  // a queued grab runs before the next outer job
   bool busy_ = false;
+  bool held_ = false;  // hold()
   uint64_t setupsDone_ = 0;
   uint64_t jobsDone_ = 0;
   std::vector<std::pair<uint64_t, std::string>> refusedUpdates_;

@@ -648,6 +648,7 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
     }
     out.worldFromShownWrist = shown_;
     out.offset = tracked.inverse() * shown_;
+    out.curl = user;
     out.blending = blending_;
     out.released = released_;
     out.constrained = blending_;
@@ -664,6 +665,7 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
     blendFrom_ = shown_;
     out.worldFromShownWrist = shown_;
     out.offset = tracked.inverse() * shown_;
+    out.curl = user;
     out.blending = true;
     out.constrained = true;
     lastTracked_ = tracked;
@@ -682,6 +684,7 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
     lastTracked_ = tracked;
     capped_.fill(false);
     for (int f = 0; f < kFingerCount; ++f) curl_[size_t(f)] = user[size_t(f)];
+    out.curl = curl_;
     // The clearance there, searched as far as a hand moves in a frame at speed: the next
     // frame's hand that moved less is clear without a search (GraspSession's fast path).
     const float searched = handClearance(tracked, kFreeReach);

@@ -82,7 +82,8 @@ struct OuterHandInput {
 struct OuterHandResult {
   Pose worldFromShownWrist;  // where the wrist is shown
   Pose offset;               // the shown wrist in the tracked wrist's frame (identity: tracked)
-  // Per finger: shown at the model's pose at curl[f] (true), or as given (false).
+  // Per finger: shown at the model's pose at curl[f] (true), or as given (false; curl[f] is then
+  // the curl the model estimates for the finger as given).
   std::array<bool, kFingerCount> capped{};
   std::array<float, kFingerCount> curl{};
   bool constrained = false;  // the shown hand differs from the input

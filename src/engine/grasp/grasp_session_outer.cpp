@@ -146,11 +146,9 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
       // the solve's, and that result moved them as given).
       if (!hand.grasp.shown()) {
         const FingerCurls now = view.model.estimateCurls(shown);
-        for (int f = 0; f < kFingerCount; ++f) {
-          if (view.fallback.capped[size_t(f)] || now[size_t(f)] <= r.curl[size_t(f)] + kCurlSlack)
-            continue;
-          view.fallback.capped[size_t(f)] = true;
-        }
+        for (int f = 0; f < kFingerCount; ++f)
+          if (now[size_t(f)] > r.curl[size_t(f)] + kCurlSlack)
+            view.fallback.capped[size_t(f)] = true;
       }
     }
   }

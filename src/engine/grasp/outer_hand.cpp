@@ -572,46 +572,30 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
   // constraints, while the parts still inside are free to come out (the slide below drops them).
   // A hand pushed partly into a table, let go, and moved on into a comb stops on the comb.
   if (released_ && !blending_) {
-    world.clear(), radii.clear();
-    std::vector<glm::vec3> moves;
-    for (int i = 0; i < count; ++i) {
-      const glm::vec3 p = parts[size_t(i)].centre;
-      world.push_back(shown_.transformPoint(p));
-      radii.push_back(parts[size_t(i)].coverRadius);
-      moves.push_back(tracked.transformPoint(p) - world.back());
-    }
-    for (const HandPart& p : in.attached) {
-      world.push_back(shown_.transformPoint(p.centre));
-      radii.push_back(p.coverRadius + attachedRadius);
-      moves.push_back(tracked.transformPoint(p.centre) - world.back());
-    }
-    const float reach = motion(shown_, tracked) + options_.margin + kActiveBand;
-    Probe atShown(*scene);
-    atShown.reset(world.size());
-    atShown(world, radii, reach, kInf);
+    // Every part where it was shown (`world`, with the probe's clearance and gradient of each).
+    handClearance(shown_, motion(shown_, tracked) + options_.margin + kActiveBand);
+    const Pose toTracked = tracked * shown_.inverse();
     std::vector<glm::vec3> arriving;
     std::vector<float> arrivingRadii;
     bool reengage = false;
     for (size_t i = 0; i < world.size() && !reengage; ++i) {
-      const float c = atShown.clearance[i];
-      const float d = glm::length(moves[i]);
-      if (c < options_.margin || c >= d + options_.margin) continue;  // inside, or nothing near
-      if (glm::dot(moves[i], atShown.gradient[i]) < 0.0f) {
+      const glm::vec3 move = toTracked.transformPoint(world[i]) - world[i];
+      const float c = probe.clearance[i];
+      if (c < options_.margin || c >= glm::length(move) + options_.margin)
+        continue;  // inside, or nothing near
+      if (glm::dot(move, probe.gradient[i]) < 0.0f) {
         reengage = true;  // toward the surface it is near
       } else {
-        arriving.push_back(world[i] + moves[i]);
+        arriving.push_back(world[i] + move);
         arrivingRadii.push_back(radii[i]);
       }
     }
     if (!reengage && !arriving.empty()) {
       // Away from the nearest surface, but another may be where it arrives.
-      Probe atTracked(*scene);
-      atTracked.reset(arriving.size());
+      probe.reset(arriving.size());
       reengage =
-          atTracked(arriving, arrivingRadii, options_.margin + kActiveBand, kInf) < options_.margin;
-      probe.samples += atTracked.samples;
+          probe(arriving, arrivingRadii, options_.margin + kActiveBand, kInf) < options_.margin;
     }
-    probe.samples += atShown.samples;
     if (reengage) {
       released_ = false;
       capped_.fill(false);

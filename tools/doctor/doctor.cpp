@@ -242,6 +242,13 @@ SystemView headMountedSystem(const Instance& instance, bool handTracking) {
   return view;
 }
 
+// The manifest of the layer the loader takes: the first it reads that enables it.
+const LayerManifest* firstEnabled(const std::vector<LayerManifest>& manifests) {
+  for (const LayerManifest& m : manifests)
+    if (m.enabled()) return &m;
+  return nullptr;
+}
+
 // Why the layer is not in the instance: the first of what the manifests, the environment and the
 // instance's creation show wrong, in the order a user has to mend them.
 void explainAbsence(Report& report) {
@@ -256,12 +263,7 @@ void explainAbsence(Report& report) {
                              " (searched: " + where + ")");
     return;
   }
-  const LayerManifest* usable = nullptr;
-  for (const LayerManifest& m : report.manifests)
-    if (m.enabled()) {
-      usable = &m;
-      break;
-    }
+  const LayerManifest* usable = firstEnabled(report.manifests);
   if (usable == nullptr) {
     const LayerManifest& m = report.manifests.front();
     if (!m.problem.empty())
@@ -517,15 +519,11 @@ Report examine(const Options& options) {
   // Left out by the loader although a manifest enables it: ask the library what the loader got.
   // Asked also when xrCreateInstance failed: a loader that loads no layer at all fails the call
   // with the layer's own error.
-  if (!report.loaded) {
-    for (const LayerManifest& m : report.manifests) {
-      if (!m.enabled() || (!m.libraryResolved.empty() && !m.libraryFound)) continue;
-      report.negotiation =
-          negotiateWithLayer(m.libraryResolved.empty() ? m.library : m.libraryResolved, kLayerName,
-                             m.negotiateFunction);
-      break;
-    }
-  }
+  if (const LayerManifest* m = firstEnabled(report.manifests);
+      !report.loaded && m != nullptr && (m->libraryResolved.empty() || m->libraryFound))
+    report.negotiation =
+        negotiateWithLayer(m->libraryResolved.empty() ? m->library : m->libraryResolved, kLayerName,
+                           m->negotiateFunction);
 
   if (report.loaded) {
     report.live = true;

@@ -1,11 +1,11 @@
 #include "manifests.h"
 
 #include <openxr/openxr.h>
+
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-
-#include <cstdio>
 
 namespace sdfg::doctor {
 namespace {

@@ -13,6 +13,7 @@
 #   incompatible_manifest the manifest's file_format_version is one the loader does not read
 #   library_unloadable    the manifest names a file that is no shared library
 #   incompatible_library  the library (REFUSING_LAYER) refuses the loader's negotiation
+#   broken_api_version    the manifest's api_version is not major.minor
 # Usage: cmake -DDOCTOR=<exe> -DRUNTIME_JSON=<mock manifest> -DLAYER_JSON=<implicit manifest>
 #          -DDISABLE_ENV=<variable> -DWORK=<scratch dir> -DCASE=<case>
 #          [-DREFUSING_LAYER=<library>] -P doctor_test.cmake
@@ -76,13 +77,16 @@ elseif(CASE STREQUAL "no_runtime")
 elseif(CASE STREQUAL "usage")
   set(args --json --bogus)
   set(expect_rc 2)
-elseif(CASE MATCHES "^(incompatible_manifest|library_unloadable|incompatible_library)$")
+elseif(CASE MATCHES
+       "^(incompatible_manifest|library_unloadable|incompatible_library|broken_api_version)$")
   # The layer's manifest, changed as the case says.
   set(install_layer OFF)
   set(expect_rc 1)
   file(READ "${LAYER_JSON}" manifest)
   if(CASE STREQUAL "incompatible_manifest")
     string(JSON manifest SET "${manifest}" file_format_version "\"1.1.0\"")
+  elseif(CASE STREQUAL "broken_api_version")
+    string(JSON manifest SET "${manifest}" api_layer api_version "\"one\"")
   elseif(CASE STREQUAL "library_unloadable")
     file(WRITE "${WORK}/not-a-library.so" "an OpenXR layer, truncated by a failed copy\n")
     string(JSON manifest SET "${manifest}" api_layer library_path "\"${WORK}/not-a-library.so\"")
@@ -220,6 +224,12 @@ elseif(CASE STREQUAL "incompatible_manifest")
   expect(OFF layer manifests 0 enabled)
   expect(OFF layer loaded)
   expect_length(0 api_layers chain)
+  expect("" layer negotiation)
+elseif(CASE STREQUAL "broken_api_version")
+  expect(broken_manifest status)
+  expect_match("has api_version 'one', not major.minor, so the loader skips it" reason)
+  expect(OFF layer manifests 0 enabled)
+  expect(OFF layer loaded)
   expect("" layer negotiation)
 elseif(CASE STREQUAL "library_unloadable")
   expect(library_unloadable status)

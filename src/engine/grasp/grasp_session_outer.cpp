@@ -17,6 +17,9 @@ constexpr float kOuterReach = 0.15f;  // metres, half the box's edge
 // A finger the fallback shows as given may be this much more closed than the last result's curl
 // (the curl estimate's own noise on a tracked hand held still).
 constexpr float kCurlSlack = 0.01f;
+// A finger whose joints moved less than this in the hand since the last result (metres) is as it
+// was then: no more closed.
+constexpr float kFingerStill = 0.0005f;
 
 float angleOf(const glm::quat& q) {
   return 2.0f * std::acos(std::min(1.0f, std::abs(q.w)));
@@ -144,11 +147,21 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
       // Fingers no further closed than that result left them: a finger the user closes more
       // while the answer is late could close into what the hand rests on (a grasp's fingers are
       // the solve's, and that result moved them as given).
+      // Only a finger that moved in the hand since can have: the curl estimate is a search (tens
+      // of microseconds for the hand) on the app's thread.
       if (!hand.grasp.shown()) {
-        const FingerCurls now = view.model.estimateCurls(shown);
-        for (int f = 0; f < kFingerCount; ++f)
-          if (now[size_t(f)] > r.curl[size_t(f)] + kCurlSlack)
+        const Pose wristThen = latest->trackedWrist.inverse();
+        for (int f = 0; f < kFingerCount; ++f) {
+          if (view.fallback.capped[size_t(f)]) continue;
+          float moved = 0.0f;
+          for (const Joint j : fingerJoints(Finger(f)))
+            moved = std::max(
+                moved, glm::length(shown[size_t(j)].position -
+                                   wristThen.transformPoint(latest->trackedJoints[size_t(j)])));
+          if (moved > kFingerStill &&
+              view.model.estimateCurl(Finger(f), shown) > r.curl[size_t(f)] + kCurlSlack)
             view.fallback.capped[size_t(f)] = true;
+        }
       }
     }
   }

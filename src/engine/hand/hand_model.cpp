@@ -505,64 +505,65 @@ int flexionFeatures(std::span<const Pose> joints, const glm::vec3& restMetacarpa
 
 }  // namespace
 
-FingerCurls HandModel::estimateCurls(std::span<const Pose, kJointCount> handSpaceJoints) const {
-  FingerCurls curls{};
+float HandModel::estimateCurl(Finger finger,
+                              std::span<const Pose, kJointCount> handSpaceJoints) const {
   std::array<Pose, kMaxFingerJoints> model;
   std::array<Pose, kMaxFingerJoints> measured;
-  for (int f = 0; f < kFingerCount; ++f) {
-    const Finger finger = static_cast<Finger>(f);
-    const auto ids = fingerJoints(finger);
-    const size_t n = ids.size();
-    bool ok = true;
-    for (size_t k = 0; k < n; ++k) {
-      measured[k] = handSpaceJoints[idx(ids[k])];
-      ok = ok && finite(measured[k].position) && finite(measured[k].orientation);
-    }
-    if (!ok) continue;  // curl 0: never hold a finger closed on bad data
-
-    fingerPose(finger, 0.0f, model);
-    const glm::vec3 rest = glm::normalize(model[1].position - model[0].position);
-    float target[kMaxFingerJoints];
-    const int count = flexionFeatures(std::span<const Pose>(measured.data(), n), rest, target);
-
-    auto cost = [&](float a) {
-      fingerPose(finger, a, model);
-      float features[kMaxFingerJoints];
-      flexionFeatures(std::span<const Pose>(model.data(), n), rest, features);
-      float sum = 0.0f;
-      for (int i = 0; i < count; ++i) sum += (features[i] - target[i]) * (features[i] - target[i]);
-      return sum;
-    };
-
-    // Coarse scan, then golden-section search around the best sample.
-    constexpr int kScan = 20;
-    int best = 0;
-    float bestCost = cost(0.0f);
-    for (int i = 1; i <= kScan; ++i) {
-      const float c = cost(static_cast<float>(i) / kScan);
-      if (c < bestCost) bestCost = c, best = i;
-    }
-    float lo = std::max(0, best - 1) / static_cast<float>(kScan);
-    float hi = std::min(kScan, best + 1) / static_cast<float>(kScan);
-    constexpr float kInvPhi = 0.6180339887f;
-    float x1 = hi - kInvPhi * (hi - lo);
-    float x2 = lo + kInvPhi * (hi - lo);
-    float c1 = cost(x1);
-    float c2 = cost(x2);
-    for (int it = 0; it < 24; ++it) {
-      if (c1 < c2) {
-        hi = x2, x2 = x1, c2 = c1;
-        x1 = hi - kInvPhi * (hi - lo);
-        c1 = cost(x1);
-      } else {
-        lo = x1, x1 = x2, c1 = c2;
-        x2 = lo + kInvPhi * (hi - lo);
-        c2 = cost(x2);
-      }
-    }
-    const float refined = 0.5f * (lo + hi);
-    curls[f] = cost(refined) <= bestCost ? refined : static_cast<float>(best) / kScan;
+  const auto ids = fingerJoints(finger);
+  const size_t n = ids.size();
+  for (size_t k = 0; k < n; ++k) {
+    measured[k] = handSpaceJoints[idx(ids[k])];
+    // Curl 0: never hold a finger closed on bad data.
+    if (!finite(measured[k].position) || !finite(measured[k].orientation)) return 0.0f;
   }
+
+  fingerPose(finger, 0.0f, model);
+  const glm::vec3 rest = glm::normalize(model[1].position - model[0].position);
+  float target[kMaxFingerJoints];
+  const int count = flexionFeatures(std::span<const Pose>(measured.data(), n), rest, target);
+
+  auto cost = [&](float a) {
+    fingerPose(finger, a, model);
+    float features[kMaxFingerJoints];
+    flexionFeatures(std::span<const Pose>(model.data(), n), rest, features);
+    float sum = 0.0f;
+    for (int i = 0; i < count; ++i) sum += (features[i] - target[i]) * (features[i] - target[i]);
+    return sum;
+  };
+
+  // Coarse scan, then golden-section search around the best sample.
+  constexpr int kScan = 20;
+  int best = 0;
+  float bestCost = cost(0.0f);
+  for (int i = 1; i <= kScan; ++i) {
+    const float c = cost(static_cast<float>(i) / kScan);
+    if (c < bestCost) bestCost = c, best = i;
+  }
+  float lo = std::max(0, best - 1) / static_cast<float>(kScan);
+  float hi = std::min(kScan, best + 1) / static_cast<float>(kScan);
+  constexpr float kInvPhi = 0.6180339887f;
+  float x1 = hi - kInvPhi * (hi - lo);
+  float x2 = lo + kInvPhi * (hi - lo);
+  float c1 = cost(x1);
+  float c2 = cost(x2);
+  for (int it = 0; it < 24; ++it) {
+    if (c1 < c2) {
+      hi = x2, x2 = x1, c2 = c1;
+      x1 = hi - kInvPhi * (hi - lo);
+      c1 = cost(x1);
+    } else {
+      lo = x1, x1 = x2, c1 = c2;
+      x2 = lo + kInvPhi * (hi - lo);
+      c2 = cost(x2);
+    }
+  }
+  const float refined = 0.5f * (lo + hi);
+  return cost(refined) <= bestCost ? refined : static_cast<float>(best) / kScan;
+}
+
+FingerCurls HandModel::estimateCurls(std::span<const Pose, kJointCount> handSpaceJoints) const {
+  FingerCurls curls{};
+  for (int f = 0; f < kFingerCount; ++f) curls[f] = estimateCurl(Finger(f), handSpaceJoints);
   return curls;
 }
 

@@ -115,6 +115,35 @@ if(PART STREQUAL "vulkan")
     message(FATAL_ERROR "the text tables show no vulkan rows:\n${out}")
   endif()
 
+  # A2. "ours" with the vulkan backend adds buffer-target rows (eval/buffer_scene.h): each mesh
+  # alone, then every scene, as "buffer_targets", method "ours/buffers", every placement graded.
+  execute_process(COMMAND "${BENCH}" --embedded-only --placements 3 --seed 2 --methods ours
+    --sdf-backend vulkan --scenes --json "${WORK}/vk-buffers.json"
+    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "--methods ours --sdf-backend vulkan --scenes exited ${rc}\n${out}\n${err}")
+  endif()
+  file(READ "${WORK}/vk-buffers.json" json)
+  string(JSON n_buffers LENGTH "${json}" buffer_targets)
+  string(JSON n_scenes LENGTH "${json}" scenes)
+  math(EXPR expected "${n_scenes} + 3")
+  if(NOT n_buffers EQUAL expected)
+    message(FATAL_ERROR "expected ${expected} buffer-target rows (3 alone, ${n_scenes} scenes), got ${n_buffers}")
+  endif()
+  math(EXPR last "${n_buffers} - 1")
+  foreach(i RANGE ${last})
+    string(JSON scene GET "${json}" buffer_targets ${i} scene)
+    string(JSON method GET "${json}" buffer_targets ${i} method)
+    string(JSON grasps GET "${json}" buffer_targets ${i} grasps)
+    if(NOT method STREQUAL "ours/buffers" OR NOT grasps EQUAL 3)
+      message(FATAL_ERROR "buffer row ${i} (${scene}): method ${method}, ${grasps} grasps")
+    endif()
+  endforeach()
+  string(JSON first GET "${json}" buffer_targets 0 scene)
+  if(NOT first STREQUAL "mug/alone" OR NOT out MATCHES "\nBuffer targets: ")
+    message(FATAL_ERROR "buffer rows: first ${first}, or no table:\n${out}")
+  endif()
+
   # B. The quick sweep prints the CPU and Vulkan columns side by side, with numbers in both.
   execute_process(COMMAND "${BENCH}" --embedded-only --placements 1 --methods paper
     --scaling-quick RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)

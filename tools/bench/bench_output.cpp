@@ -78,9 +78,10 @@ tools::Json resultsJson(const Options& o, const std::vector<Row>& rows) {
 }
 
 bool writeJson(const std::string& file, const Options& o, const std::vector<Row>& rows,
-               const std::vector<SceneRow>& sceneRows) {
+               const std::vector<SceneRow>& sceneRows, const std::vector<SceneRow>& bufferRows) {
   tools::Json out = resultsJson(o, rows);
   if (o.scenes) out["scenes"] = scenesJson(sceneRows);
+  if (!bufferRows.empty()) out["buffer_targets"] = scenesJson(bufferRows);
   return !tools::writeJsonFile(file, out).has_value();
 }
 

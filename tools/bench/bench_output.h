@@ -16,9 +16,11 @@ namespace sdfg::bench {
 // build (json_file.h), and one object per row with its figures (null where there are none).
 tools::Json resultsJson(const Options& o, const std::vector<Row>& rows);
 // resultsJson() into `file`; false when it cannot be written.
-// With --scenes, `sceneRows` as its "scenes" array (scenesJson()).
+// With --scenes, `sceneRows` as its "scenes" array (scenesJson()); `bufferRows` (buffer
+// targets, runBufferScenes()) as "buffer_targets" when there are any.
 bool writeJson(const std::string& file, const Options& o, const std::vector<Row>& rows,
-               const std::vector<SceneRow>& sceneRows = {});
+               const std::vector<SceneRow>& sceneRows = {},
+               const std::vector<SceneRow>& bufferRows = {});
 void printTables(const Options& o, const std::vector<Row>& rows);
 
 }  // namespace sdfg::bench

@@ -107,6 +107,13 @@ int main(int argc, char** argv) {
 
   bool failed = false;
   std::vector<Row> rows;
+  // With --sdf-backend vulkan, "ours" on buffer targets: each mesh alone (the single-object
+  // rows), then with --scenes every scene, through a GraspSession on a device of its own.
+  const bool bufferRowsWanted =
+      std::find(o.sdfBackends.begin(), o.sdfBackends.end(), tools::kVulkanBackend) !=
+          o.sdfBackends.end() &&
+      std::find(o.methods.begin(), o.methods.end(), "ours") != o.methods.end();
+  std::vector<BenchScene> bufferScenes;
   // --scenes: each mesh that ran on a table, then the scenes of several objects (embedded ones).
   std::vector<BenchScene> scenes;
   bool embeddedRan = false;
@@ -143,6 +150,10 @@ int main(int argc, char** argv) {
     for (Row& r : *meshRows) {
       failed = failed || r.failedSolves > 0;
       rows.push_back(std::move(r));
+    }
+    if (bufferRowsWanted) {
+      bufferScenes.push_back(
+          aloneScene(source.path ? source.path->filename().string() : source.name, *mesh));
     }
     // A file is named with its extension: the shared torus.obj apart from the embedded torus.
     if (o.scenes) {
@@ -201,6 +212,19 @@ int main(int argc, char** argv) {
     }
     sceneRows = runScenes(scenes, o, box, threads, failed);
     printSceneTable(sceneRows);
+    if (bufferRowsWanted) bufferScenes.insert(bufferScenes.end(), scenes.begin(), scenes.end());
+  }
+  std::vector<SceneRow> bufferRows;
+  if (bufferRowsWanted) {
+    bool available = false;
+    bufferRows = runBufferScenes(bufferScenes, o, box, threads, failed, available);
+    backendMissing = backendMissing || !available;
+    if (available) {
+      printSceneTable(bufferRows,
+                      "Buffer targets: \"ours\" through a GraspSession whose meshes are in a "
+                      "Vulkan device's buffers (read back, set up and built as the layer does for "
+                      "XrGraspTargetVulkanBuffersSDFG); each mesh alone, then the scenes");
+    }
   }
   if (o.approaching) {
     std::printf(
@@ -209,7 +233,7 @@ int main(int argc, char** argv) {
     printApproachingTable(stdout, rows);
   }
   if (!o.report.empty() && o.json.empty()) o.json = bench::reportResultsPath(o.report).string();
-  if (!o.json.empty() && !writeJson(o.json, o, rows, sceneRows)) {
+  if (!o.json.empty() && !writeJson(o.json, o, rows, sceneRows, bufferRows)) {
     std::fprintf(stderr, "autograsp-bench: cannot write %s\n", o.json.c_str());
     failed = true;
   }

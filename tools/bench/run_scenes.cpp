@@ -4,11 +4,17 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
+
+#if SDFG_BENCH_HAVE_VULKAN
+#include "eval/buffer_scene.h"
+#endif
 
 namespace sdfg::bench {
 
-std::vector<SceneRow> runScenes(const std::vector<BenchScene>& scenes, const Options& o,
-                                const GridBox& box, unsigned threads, bool& failed) {
+namespace {
+
+SceneRun sceneRun(const Options& o, const GridBox& box, unsigned threads) {
   SceneRun run;
   run.placements = o.placements;
   run.seed = o.seed;
@@ -17,37 +23,81 @@ std::vector<SceneRow> runScenes(const std::vector<BenchScene>& scenes, const Opt
   run.options.clearance = o.clearHand;
   run.exactCheck = o.exactCheck;
   run.box = box;
+  return run;
+}
+
+std::string objectList(const BenchScene& scene) {
+  std::string objects;
+  for (const SceneObject& obj : scene.objects) {
+    if (!objects.empty()) objects += ", ";
+    objects += obj.name + (obj.graspable ? " (graspable)" : " (scene)");
+  }
+  return objects;
+}
+
+// One scene's row of `run` (named `method`), or nothing with the reason on stderr.
+void addRow(const BenchScene& scene, const SceneRun& run, const std::string& method,
+            std::vector<SceneRow>& rows, bool& failed) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Result<SceneFigures> figures = measureScene(scene, run);
+  if (!figures) {
+    std::fprintf(stderr, "autograsp-bench: scene %s, %s: %s\n", scene.name.c_str(), method.c_str(),
+                 figures.error().message.c_str());
+    failed = true;
+    return;
+  }
+  std::fprintf(stderr, "scene %s, %s: %d grasps in %.1f s\n", scene.name.c_str(), method.c_str(),
+               figures->grasps,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  rows.push_back(SceneRow{scene.name, scene.description, objectList(scene), method, *figures});
+}
+
+}  // namespace
+
+std::vector<SceneRow> runBufferScenes(const std::vector<BenchScene>& scenes, const Options& o,
+                                      const GridBox& box, unsigned threads, bool& failed,
+                                      bool& available) {
+  std::vector<SceneRow> rows;
+#if SDFG_BENCH_HAVE_VULKAN
+  auto solver = BufferSceneSolver::create();
+  available = solver.ok();
+  if (!solver) {
+    std::fprintf(stderr, "autograsp-bench: buffer targets: %s; their rows are left out\n",
+                 solver.error().message.c_str());
+    return rows;
+  }
+  std::fprintf(stderr, "autograsp-bench: buffer targets on %s\n", (*solver)->deviceName().c_str());
+  SceneRun run = sceneRun(o, box, threads);
+  run.solves = (*solver)->solves(run);
+  for (const BenchScene& scene : scenes) addRow(scene, run, "ours/buffers", rows, failed);
+#else
+  (void)scenes, (void)o, (void)box, (void)threads, (void)failed;
+  available = false;
+  std::fprintf(stderr, "autograsp-bench: buffer targets: built without Vulkan\n");
+#endif
+  return rows;
+}
+
+std::vector<SceneRow> runScenes(const std::vector<BenchScene>& scenes, const Options& o,
+                                const GridBox& box, unsigned threads, bool& failed) {
+  SceneRun run = sceneRun(o, box, threads);
   std::vector<SceneRow> rows;
   for (const BenchScene& scene : scenes) {
-    std::string objects;
-    for (const SceneObject& obj : scene.objects) {
-      if (!objects.empty()) objects += ", ";
-      objects += obj.name + (obj.graspable ? " (graspable)" : " (scene)");
-    }
     for (const std::string& method : o.methods) {
       run.method = method;
-      const auto t0 = std::chrono::steady_clock::now();
-      const Result<SceneFigures> figures = measureScene(scene, run);
-      if (!figures) {
-        std::fprintf(stderr, "autograsp-bench: scene %s, %s: %s\n", scene.name.c_str(),
-                     method.c_str(), figures.error().message.c_str());
-        failed = true;
-        continue;
-      }
-      std::fprintf(stderr, "scene %s, %s: %d grasps in %.1f s\n", scene.name.c_str(),
-                   method.c_str(), figures->grasps,
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-      rows.push_back(SceneRow{scene.name, scene.description, objects, method, *figures});
+      addRow(scene, run, method, rows, failed);
     }
   }
   return rows;
 }
 
-void printSceneTable(const std::vector<SceneRow>& rows) {
-  std::printf(
-      "\nScenes: the whole hand inside objects it does not hold (mm, per grasp's deepest), "
-      "grasps that took another graspable object than the one the palm faces, and the "
-      "single-object figures on the object held\n");
+void printSceneTable(const std::vector<SceneRow>& rows, const char* title) {
+  std::printf("\n%s\n", title != nullptr
+                            ? title
+                            : "Scenes: the whole hand inside objects it does not hold (mm, per "
+                              "grasp's deepest), grasps that took another graspable object than "
+                              "the one the palm faces, and the single-object figures on the "
+                              "object held");
   int width = 20;
   for (const SceneRow& r : rows) width = std::max(width, int(r.scene.size()));
   std::printf("%-*s %-15s %7s %9s %9s %11s %8s %9s %9s %9s %6s %5s\n", width, "scene", "method",

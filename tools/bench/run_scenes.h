@@ -26,7 +26,16 @@ struct SceneRow {
 std::vector<SceneRow> runScenes(const std::vector<BenchScene>& scenes, const Options& o,
                                 const GridBox& box, unsigned threads, bool& failed);
 
-void printSceneTable(const std::vector<SceneRow>& rows);
+// With --sdf-backend vulkan: "ours" in every scene of `scenes` through a GraspSession whose
+// meshes are buffer targets in a Vulkan device's buffers (eval/buffer_scene.h), method
+// "ours/buffers". `available` is false (and nothing runs) where the tools have no Vulkan or no
+// device could be made (the reason on stderr); a scene that fails sets `failed`.
+std::vector<SceneRow> runBufferScenes(const std::vector<BenchScene>& scenes, const Options& o,
+                                      const GridBox& box, unsigned threads, bool& failed,
+                                      bool& available);
+
+// `title` heads the table (default: the scenes').
+void printSceneTable(const std::vector<SceneRow>& rows, const char* title = nullptr);
 
 // The rows as the JSON's "scenes" array (one object per scene and method).
 tools::Json scenesJson(const std::vector<SceneRow>& rows);

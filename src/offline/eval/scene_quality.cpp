@@ -250,6 +250,84 @@ Result<SceneFigures> measureScene(const BenchScene& scene, const SceneRun& run) 
   float reach = 0.0f;
   for (int j = 0; j < kJointCount; ++j) reach = std::max(reach, hand.jointRadius(Joint(j)));
 
+  // Solves placement `p` with the method's own rule for what it takes (see the header).
+  auto solveHere = [&](unsigned t, size_t p, const glm::vec3& palm, SdfGrid& grid, SdfGrid& scratch,
+                       SdfBackend& backend, SceneSolve& out) -> std::optional<Error> {
+    const Pose& worldFromHand = placements[p].objectFromHand;
+    GraspScene graspScene;
+    graspScene.objectFromHand = worldFromHand;
+    if (physics) graspScene.collider = colliders[t].get();
+    std::vector<SceneMember> members;
+    int paperTarget = -1;
+    if (sceneAware) {
+      for (size_t i = 0; i < objects.size(); ++i) {
+        SceneMember m;
+        m.id = i + 1;
+        m.mesh = objects[i].distance.get();
+        m.shape = scene.objects[i].shape ? &*scene.objects[i].shape : nullptr;
+        m.objectFromHand = scene.objects[i].worldFromObject.inverse() * worldFromHand;
+        m.graspable = scene.objects[i].graspable;
+        members.push_back(m);
+      }
+    } else if (!physics) {
+      paperTarget = nearestBoundsTarget(objects, scene, palm);
+      SceneMember m;
+      m.id = size_t(paperTarget) + 1;
+      m.mesh = objects[size_t(paperTarget)].distance.get();
+      m.objectFromHand =
+          scene.objects[size_t(paperTarget)].worldFromObject.inverse() * worldFromHand;
+      m.graspable = true;
+      members.push_back(m);
+    }
+    if (!members.empty()) {
+      if (Status s = buildSceneField(members, run.box, backend, grid, scratch); s != Status::ok) {
+        return makeError(
+            s, "scene " + scene.name + ": SDF build failed on placement " + std::to_string(p));
+      }
+      graspScene.field = &grid;
+    }
+    const SceneExactSource exact(members);
+    if (sceneAware && run.exactCheck) graspScene.exact = &exact;
+    GraspResult& result = out.result;
+    if (Status s = solvers[t]->solve(graspScene, result); s != Status::ok) {
+      return makeError(s, "scene " + scene.name + ": " + run.method +
+                              " solve failed on placement " + std::to_string(p) + " (" +
+                              toString(s) + ")");
+    }
+    if (sceneAware) {
+      const GraspChoice choice =
+          chooseTarget(members, exact, result, handFromPalm.position, hand.jointRadius(Joint::palm),
+                       palmFacing(handFromPalm), reach + kTouchReach);
+      out.taken = choice.member;  // members are the objects, in order
+      out.touched = choice.touched;
+      if (out.taken >= 0) {
+        // The contacts as the worker computes them (grasp_worker.cpp).
+        const size_t o = size_t(out.taken);
+        out.contacts = computeContacts(hand, result, members[o].objectFromHand,
+                                       objects[o].distance.get(), &grid);
+      }
+    } else if (physics) {
+      out.taken = physicsTaken(objects, scene, worldFromHand, result, palm);
+    } else {
+      bool contact = false;
+      for (const FingerState& f : result.fingers) contact = contact || f.contact;
+      out.taken = contact ? paperTarget : -1;
+    }
+    return std::nullopt;
+  };
+
+  std::vector<SceneSolve> solvedElsewhere;
+  if (run.solves) {
+    Result<std::vector<SceneSolve>> solved = run.solves(scene, placements);
+    if (!solved) return solved.error();
+    if (solved->size() != placements.size()) {
+      return makeError(Status::internal, "scene " + scene.name + ": " +
+                                             std::to_string(solved->size()) + " solves for " +
+                                             std::to_string(placements.size()) + " placements");
+    }
+    solvedElsewhere = std::move(*solved);
+  }
+
   std::vector<Graded> graded(placements.size());
   std::atomic<size_t> next{0};
   auto work = [&](unsigned t) {
@@ -258,79 +336,29 @@ Result<SceneFigures> measureScene(const BenchScene& scene, const SceneRun& run) 
     for (size_t p = next++; p < placements.size(); p = next++) {
       Graded& g = graded[p];
       const Pose& worldFromHand = placements[p].objectFromHand;
-      GraspResult result;
-      GraspScene graspScene;
-      graspScene.objectFromHand = worldFromHand;
-      if (physics) {
-        graspScene.collider = colliders[t].get();
-      }
-      std::vector<SceneMember> members;
-      int paperTarget = -1;
       const glm::vec3 palm = worldFromHand.transformPoint(handFromPalm.position);
-      if (sceneAware) {
-        for (size_t i = 0; i < objects.size(); ++i) {
-          SceneMember m;
-          m.id = i + 1;
-          m.mesh = objects[i].distance.get();
-          m.shape = scene.objects[i].shape ? &*scene.objects[i].shape : nullptr;
-          m.objectFromHand = scene.objects[i].worldFromObject.inverse() * worldFromHand;
-          m.graspable = scene.objects[i].graspable;
-          members.push_back(m);
-        }
-      } else if (!physics) {
-        paperTarget = nearestBoundsTarget(objects, scene, palm);
-        SceneMember m;
-        m.id = size_t(paperTarget) + 1;
-        m.mesh = objects[size_t(paperTarget)].distance.get();
-        m.objectFromHand =
-            scene.objects[size_t(paperTarget)].worldFromObject.inverse() * worldFromHand;
-        m.graspable = true;
-        members.push_back(m);
-      }
-      if (!members.empty()) {
-        if (Status s = buildSceneField(members, run.box, *backend, grid, scratch);
-            s != Status::ok) {
-          g.error = makeError(
-              s, "scene " + scene.name + ": SDF build failed on placement " + std::to_string(p));
-          continue;
-        }
-        graspScene.field = &grid;
-      }
-      const SceneExactSource exact(members);
-      if (sceneAware && run.exactCheck) graspScene.exact = &exact;
-      if (Status s = solvers[t]->solve(graspScene, result); s != Status::ok) {
-        g.error =
-            makeError(s, "scene " + scene.name + ": " + run.method + " solve failed on placement " +
-                             std::to_string(p) + " (" + toString(s) + ")");
+      SceneSolve solved;
+      if (!solvedElsewhere.empty()) {
+        solved = solvedElsewhere[p];
+      } else if (std::optional<Error> e = solveHere(t, p, palm, grid, scratch, *backend, solved)) {
+        g.error = std::move(e);
         continue;
       }
+      const GraspResult& result = solved.result;
       g.exceeded = result.clearanceExceeded;
-      if (sceneAware) {
-        const GraspChoice choice = chooseTarget(members, exact, result, handFromPalm.position,
-                                                hand.jointRadius(Joint::palm),
-                                                palmFacing(handFromPalm), reach + kTouchReach);
-        g.taken = choice.member;  // members are the objects, in order
-        if (g.taken >= 0) {
-          // What XrGraspFingerStateSDFG reports: the contacts on the object taken, as the worker
-          // computes them (grasp_worker.cpp), checked against the grader's exact distance.
-          const size_t t = size_t(g.taken);
-          const FingerContacts contacts = computeContacts(hand, result, members[t].objectFromHand,
-                                                          objects[t].distance.get(), &grid);
-          for (int f = 0; f < kFingerCount; ++f) {
-            const FingerContact& c = contacts[size_t(f)];
-            if (!c.valid || choice.touched[size_t(f)] != g.taken) continue;
-            const glm::vec3 world = scene.objects[t].worldFromObject.transformPoint(c.center);
-            const double d = objects[t].exact->signedDistance(world);
-            g.v1ResidualMm = std::max(g.v1ResidualMm, float(1000.0 * std::abs(d - c.distance)));
-            ++g.v1Contacts;
-          }
+      g.taken = solved.taken;
+      if (sceneAware && g.taken >= 0) {
+        // What XrGraspFingerStateSDFG reports: the contacts on the object taken, checked against
+        // the grader's exact distance.
+        const size_t o = size_t(g.taken);
+        for (int f = 0; f < kFingerCount; ++f) {
+          const FingerContact& c = solved.contacts[size_t(f)];
+          if (!c.valid || solved.touched[size_t(f)] != g.taken) continue;
+          const glm::vec3 world = scene.objects[o].worldFromObject.transformPoint(c.center);
+          const double d = objects[o].exact->signedDistance(world);
+          g.v1ResidualMm = std::max(g.v1ResidualMm, float(1000.0 * std::abs(d - c.distance)));
+          ++g.v1Contacts;
         }
-      } else if (physics) {
-        g.taken = physicsTaken(objects, scene, worldFromHand, result, palm);
-      } else {
-        bool contact = false;
-        for (const FingerState& f : result.fingers) contact = contact || f.contact;
-        g.taken = contact ? paperTarget : -1;
       }
       g.faced = facedObject(objects, worldFromHand * handFromPalm);
       for (size_t i = 0; i < objects.size(); ++i) {

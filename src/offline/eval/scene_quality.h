@@ -28,17 +28,39 @@
 //    an early stop only where no other object is within the early-stop gap either.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "base/status.h"
+#include "eval/placements.h"
 #include "eval/quality.h"
 #include "eval/scenes.h"
+#include "grasp/contact.h"
 #include "grasp/solver.h"
 #include "sdf/sdf_grid.h"
 
 namespace sdfg {
+
+// What "ours" did at one placement, when something other than measureScene() solved it.
+struct SceneSolve {
+  GraspResult result;  // hand space, as a solver returns it
+  int taken = -1;      // the object held (index into BenchScene::objects); -1: none
+  // Per finger, the object its contact is on (-1: none), and where it touches the object taken
+  // (that object's frame): what XrGraspTouchesSDFG and XrGraspFingerStateSDFG report.
+  std::array<int, kFingerCount> touched{-1, -1, -1, -1, -1};
+  FingerContacts contacts{};
+};
+
+// Solves every placement of a scene, in order, one SceneSolve each: "ours" run somewhere else
+// than in measureScene() (eval/buffer_scene.h: through a GraspSession whose meshes live in a
+// Vulkan device's buffers, as the layer runs an app's buffer targets). The placements' hand
+// frames are in the scene's world frame.
+using SceneSolves = std::function<Result<std::vector<SceneSolve>>(
+    const BenchScene& scene, std::span<const Placement> placements)>;
 
 struct SceneRun {
   std::string method = "ours";  // any strategy of createAnySolver()
@@ -51,6 +73,9 @@ struct SceneRun {
   // Approaching hands (eval/approaching.h): the palm from 1 cm inside to 5 cm outside the object
   // reached for, open hands inside it kept (those inside another object are drawn again).
   bool approaching = false;
+  // "ours" only: where the placements are solved (empty: here, on the CPU, as the worker does).
+  // The grading is the same either way.
+  SceneSolves solves;
 };
 
 struct SceneFigures {

@@ -48,6 +48,17 @@ SceneObject makeTable() {
   return boxObject("table", kTableHalf, glm::vec3(0.0f, -kTableHalf.y, 0.0f));
 }
 
+BenchScene aloneScene(const std::string& name, const TriangleMesh& mesh) {
+  BenchScene scene;
+  scene.name = name + "/alone";
+  scene.description = name + " (scaled to the benchmark's size) alone";
+  SceneObject object;
+  object.name = name;
+  object.mesh = normalizedToDiagonal(mesh, kBenchObjectDiagonal);
+  scene.objects.push_back(std::move(object));
+  return scene;
+}
+
 BenchScene tableScene(const std::string& name, const TriangleMesh& mesh) {
   BenchScene scene;
   scene.name = name + "/table";

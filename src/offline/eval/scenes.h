@@ -40,6 +40,11 @@ SceneObject makeTable();
 // resting on the table: its lowest point on the table top, centred over it. Name "<name>/table".
 BenchScene tableScene(const std::string& name, const TriangleMesh& mesh);
 
+// `mesh` alone, scaled to the benchmark's object size and centred on the world's origin, as the
+// single-object benchmark places it (eval/quality.h): a scene's figures on it are the
+// single-object figures. Name "<name>/alone".
+BenchScene aloneScene(const std::string& name, const TriangleMesh& mesh);
+
 // The scenes of objects among objects, all of them at real size on the table:
 //  - "mug-beside-mug": two mugs 5 mm apart (the second turned so its handle points away), both
 //    graspable, the hand reaching for the first; "mug-near-mug": the same 1 cm apart;

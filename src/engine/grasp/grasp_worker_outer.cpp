@@ -1,0 +1,129 @@
+// GraspWorker's outer-hand jobs: each hand kept outside the targets near it, one job per frame,
+// the newest replacing one not yet started.
+#include "grasp/grasp_worker.h"
+
+#include "grasp/scene_exact_source.h"
+#include "grasp/target_choice.h"
+#include "scene/scene_field.h"
+
+#include <algorithm>
+#include <limits>
+#include <new>
+#include <utility>
+
+namespace sdfg {
+
+void GraspWorker::requestOuter(size_t slot, OuterJob job) {
+  {
+    std::lock_guard lock(mutex_);
+    outer_[slot].queued = std::move(job);
+  }
+  wake_.notify_all();
+}
+
+void GraspWorker::resetOuter(size_t slot) {
+  std::lock_guard lock(mutex_);
+  outer_[slot].queued.reset();
+  outer_[slot].reset = true;
+}
+
+void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, OuterJob job) {
+  OuterSlot& o = outer_[slot];
+  const bool reset = o.reset;
+  o.reset = false;
+  // The members as the exact source sees them (meshes and shapes; device targets have no CPU
+  // mesh and are not kept out), looked up under the lock and read outside it: only this thread
+  // touches a target's distance structure.
+  std::vector<std::shared_ptr<Target>> keep;
+  std::vector<SceneMember> scene;
+  for (const JobMember& m : job.members) {
+    if (m.target == job.attached) continue;
+    auto it = targets_.find(m.target);
+    if (it == targets_.end() || it->second->setup != TargetSetup::ready) continue;
+    const Target& t = *it->second;
+    if (t.distance == nullptr && !t.shape) continue;
+    keep.push_back(it->second);
+    scene.push_back(sceneMember(m, t));
+    if (scene.size() == kMaxSceneMembers) break;
+  }
+  std::shared_ptr<Target> attached;
+  uint64_t attachedVersion = 0;
+  if (job.attached != 0) {
+    auto it = targets_.find(job.attached);
+    if (it != targets_.end() && it->second->setup == TargetSetup::ready) {
+      attached = it->second;
+      attachedVersion = attached->appliedVersion;
+    }
+  }
+  const uint64_t setupsBefore = setupsDone_;
+  lock.unlock();
+  auto done = std::make_shared<OuterDone>();
+  done->ticket = job.ticket;
+  done->setupsBefore = setupsBefore;
+  done->trackedWrist = job.worldFromWrist;
+  for (int j = 0; j < kJointCount; ++j) {
+    done->trackedJoints[size_t(j)] =
+        job.worldFromWrist.transformPoint(job.joints[size_t(j)].position);
+    done->radii[size_t(j)] = job.radii[size_t(j)];
+  }
+  try {
+    if (reset && o.hand != nullptr) o.hand->reset();
+    if (o.hand == nullptr)
+      o.hand = std::make_unique<OuterHand>(job.model, job.options);
+    else
+      o.hand->setModel(job.model);
+    o.hand->setOptions(job.options);
+    // The held object's surface, sampled once per target and shape.
+    std::vector<HandPart> parts;
+    if (attached != nullptr) {
+      if (o.sampledTarget != job.attached || o.sampledVersion != attachedVersion) {
+        o.samples = attached->shape                 ? surfaceParts(*attached->shape)
+                    : attached->distance != nullptr ? surfaceParts(attached->distance->mesh())
+                                                    : std::vector<HandPart>{};
+        o.sampledTarget = job.attached;
+        o.sampledVersion = attachedVersion;
+      }
+      parts.reserve(o.samples.size());
+      for (HandPart p : o.samples) {
+        p.centre = job.wristFromAttached.transformPoint(p.centre);
+        done->attachedReach = std::max(done->attachedReach, glm::length(p.centre));
+        parts.push_back(p);
+      }
+    }
+    OuterHandInput in;
+    in.worldFromWrist = job.worldFromWrist;
+    in.joints = &job.joints;
+    in.radii = &job.radii;
+    in.time = job.time;
+    in.attached = parts;
+    in.rigidFingers = job.rigidFingers;
+    in.drawnOffset = job.drawnOffset;
+    // A target that moved since the last job may now be in the hand shown then. (One that only
+    // came within reach did not: the hand's own motion brought it.)
+    std::vector<std::pair<uint64_t, Pose>> now;
+    for (const SceneMember& m : scene) now.emplace_back(m.id, m.objectFromHand);
+    in.sceneMoved = std::any_of(now.begin(), now.end(), [&](const auto& m) {
+      return std::any_of(o.lastScene.begin(), o.lastScene.end(), [&](const auto& was) {
+        return was.first == m.first && (was.second.position != m.second.position ||
+                                        was.second.orientation != m.second.orientation);
+      });
+    });
+    o.lastScene = std::move(now);
+    const SceneExactSource source(scene);
+    auto r = o.hand->update(in, scene.empty() ? nullptr : &source);
+    if (r)
+      done->result = *r;
+    else
+      done->status = r.error().code;
+  } catch (const std::bad_alloc&) {
+    done->status = Status::out_of_memory;
+  } catch (...) {
+    done->status = Status::internal;
+  }
+  keep.clear();
+  attached.reset();
+  o.mailbox->latest.store(std::move(done));
+  lock.lock();
+}
+
+}  // namespace sdfg

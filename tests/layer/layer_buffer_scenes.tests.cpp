@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <string>
@@ -312,18 +313,28 @@ TEST_CASE("A box in the app's buffers carried down into the table it lay on stay
   });
 }
 
-TEST_CASE("Two boxes in the app's buffers side by side: one is taken, neither is entered",
-          "[layer][vulkan][scenes]") {
+TEST_CASE(
+    "A box in the app's buffers beside another in its buffers or on the CPU: one is taken, "
+    "neither is entered",
+    "[layer][vulkan][scenes]") {
   if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  const bool otherOnCpu = GENERATE(false, true);
+  CAPTURE(otherOnCpu);
   validated([&] {
     // 2 cm apart across the fingers, each 6 cm wide: the palm faces the gap's edge of one.
     BufferScene scene(/*meshTable=*/false, /*withTable=*/false, kClear, -0.04f);
     const XrPosef otherPose = awayFromPalm(belowOpenRightPalm(scene.mesh, kGrip, facingPalm(kGrip),
                                                               openRightHand(kGrip).across * 0.04f),
                                            kClear);
-    BufferMesh otherBuffers = uploadMesh(*scene.app, scene.mesh, 1.0f);
-    const XrGraspTargetSDFG other = scene.addBuffers(otherBuffers, otherPose);
-    scene.waitReady(2);  // both read back, one readback at a time
+    BufferMesh otherBuffers;
+    XrGraspTargetSDFG other = XR_NULL_HANDLE;
+    if (otherOnCpu) {
+      other = makeTarget(*scene.app, *scene.ext, scene.mesh, otherPose);
+    } else {
+      otherBuffers = uploadMesh(*scene.app, scene.mesh, 1.0f);
+      other = scene.addBuffers(otherBuffers, otherPose);
+    }
+    scene.waitReady(2);  // both set up (buffers: read back, one readback at a time)
     scene.squeezeNow();
     BufferScene::State s;
     REQUIRE(runUntil(*scene.app, [&] {
@@ -342,5 +353,43 @@ TEST_CASE("Two boxes in the app's buffers side by side: one is taken, neither is
     const Joints j = scene.joints();
     CHECK(depthInBox(j, boxShape(kHalf), scene.boxPose) <= 0.0005f);
     CHECK(depthInBox(j, boxShape(kHalf), otherPose) <= 0.0005f);
+  });
+}
+
+TEST_CASE("A box in the app's buffers that the app grows into a still open hand pushes it out",
+          "[layer][vulkan][outer_hand]") {
+  if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  validated([&] {
+    // The open hand 3 mm clear of the box, squeeze 0; the app grows the box about its centre,
+    // 0.5 mm a frame toward the palm (a skinned mesh's new poses), to 6 mm past where the hand
+    // started, each step written and said with an update.
+    BufferScene scene(/*meshTable=*/false, /*withTable=*/false, kClear + 0.003f);
+    auto update =
+        scene.app->fn<PFN_xrUpdateGraspTargetVerticesSDFG>("xrUpdateGraspTargetVerticesSDFG");
+    const int steps = 18;
+    float scale = 1.0f, startDepth = 1.0f, deepest = -1.0f;
+    int k = 0;
+    pacedFrames(*scene.app, steps + 30, [&] {
+      if (k > 0 && k <= steps) {
+        scale = 1.0f + float(k) * 0.0005f / kHalf.y;
+        writeVertices(scene.buffers, scene.mesh, scale);
+        REQUIRE(update(scene.box, &scene.buffers.desc) == XR_SUCCESS);
+      }
+      Joints j;
+      REQUIRE(locateJoints(*scene.app, scene.tracker, j) == XR_SUCCESS);
+      const float depth = depthInBox(j, boxShape(kHalf, scale), scene.boxPose);
+      if (k == 0) startDepth = depth;
+      deepest = std::max(deepest, depth);
+      ++k;
+    });
+    std::printf("growing buffer box: shown hand at most %.2f mm inside (started %.2f mm clear)\n",
+                1000.0f * deepest, -1000.0f * startDepth);
+    CHECK(startDepth < 0.0f);
+    // The tracked hand ends 3 mm inside the grown box; the shown one is pushed out with it (a
+    // readback behind the app's write: up to 1.5 mm while it grows).
+    CHECK(deepest <= 0.0015f);
+    Joints j;
+    REQUIRE(locateJoints(*scene.app, scene.tracker, j) == XR_SUCCESS);
+    CHECK(depthInBox(j, boxShape(kHalf, scale), scene.boxPose) <= 0.001f);
   });
 }

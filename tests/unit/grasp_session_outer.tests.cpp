@@ -325,3 +325,37 @@ TEST_CASE("Session outer hand: a held object is kept out of the table with the h
   // Surface samples: a table face between them can dent the block by their spacing.
   CHECK(deepest <= 0.0015f);
 }
+
+TEST_CASE("Session outer hand: a mesh the app deforms into a still open hand pushes it out",
+          "[core][outer_hand]") {
+  // A slab mesh (a table top as an app's skinned mesh) whose top the app raises 0.5 mm a frame
+  // by new vertices, from 4 mm under the hand to 4 mm into where it was; paced at 90 Hz and drawn
+  // at once. The outer hand sees each new shape (the worker refits before the job), so the shown
+  // hand rises with the top.
+  Rig rig;
+  rig.paced = true;
+  const glm::vec3 half(0.2f, 0.02f, 0.2f);
+  TriangleMesh slab = makeBox(2.0f * half);
+  const Pose worldFromSlab = at(glm::vec3(0.0f, -half.y, 0.0f));  // its top at y = 0
+  rig.addMesh(1, slab, worldFromSlab);
+  const float wristY = touchHeight(rig) + 0.004f;
+  std::vector<glm::vec3> positions = slab.positions;
+  float deepest = -1.0f, trackedDeepest = -1.0f, rise = 0.0f;
+  for (int k = 0; k <= 40; ++k) {
+    if (k > 0 && k <= 16) {
+      rise = 0.0005f * float(k);
+      for (size_t v = 0; v < positions.size(); ++v)
+        positions[v].y = slab.positions[v].y > 0.0f ? half.y + rise : slab.positions[v].y;
+      REQUIRE(rig.session.updateTargetVertices(1, positions) == Status::ok);
+    }
+    const AnalyticShape now{ShapeKind::box, glm::vec3(half.x, half.y + 0.5f * rise, half.z)};
+    const Pose worldFromNow = at(glm::vec3(0.0f, -half.y + 0.5f * rise, 0.0f));
+    const Pose wrist = at(glm::vec3(0.0f, wristY, 0.0f));
+    const JointPoses drawn = rig.frame(wrist);
+    deepest = std::max(deepest, depthIn(drawn, rig.radii, now, worldFromNow));
+    trackedDeepest =
+        std::max(trackedDeepest, depthIn(rig.tracked(wrist), rig.radii, now, worldFromNow));
+  }
+  CHECK(trackedDeepest > 0.003f);  // the top ends 4 mm into the tracked hand
+  CHECK(deepest <= 0.001f);
+}

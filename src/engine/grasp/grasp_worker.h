@@ -289,8 +289,13 @@ class GraspWorker {
     uint64_t sampledTarget = 0;
     uint64_t sampledVersion = 0;
     std::vector<HandPart> samples;
-    // The members of the last job run (target, objectFromHand): whether the scene moved since.
-    std::vector<std::pair<uint64_t, Pose>> lastScene;
+    // The members of the last job run: whether the scene moved, or changed its shape, since.
+    struct Seen {
+      uint64_t id = 0;
+      Pose objectFromHand;
+      uint64_t version = 0;  // of the vertices
+    };
+    std::vector<Seen> lastScene;
   };
   struct Slot {
     std::optional<Job> queued;
@@ -307,6 +312,31 @@ class GraspWorker {
   static constexpr size_t kMaxSpares = 3;
   // Moves `buffers` into the target's pool up to kMaxSpares (caller holds the mutex).
   static void keepSpares(Target& target, std::vector<std::vector<glm::vec3>>& buffers);
+
+  // A job member's target as the job found it, with the new positions it applies first (a grasp
+  // job before its build, an outer-hand job before it looks: a deforming target is seen as the
+  // app last wrote it by either).
+  struct Resolved {
+    uint64_t id = 0;
+    std::shared_ptr<Target> target;  // null: removed, or not set up
+    std::optional<std::vector<glm::vec3>> positions;
+    uint64_t version = 0;  // the vertex version the job sees
+    size_t missingSpares = 0;
+    std::optional<Aabb> refitBounds;
+  };
+  // Takes the target's waiting positions (caller holds the mutex; `target` set up).
+  static Resolved resolve(uint64_t id, std::shared_ptr<Target> target);
+  // Fills the pools of deforming targets (takes and releases the held lock around allocations).
+  void fillSpares(std::unique_lock<std::mutex>& lock, std::span<Resolved> resolved);
+  // Refits each target that has new positions (lock not held). Positions that collapse a
+  // triangle are refused (the first of a run into `refused`) and the last shape stays whole;
+  // timed_out when a target is being dropped.
+  static Status refit(std::span<Resolved> resolved,
+                      std::vector<std::pair<uint64_t, std::string>>& refused);
+  // Records what the refits applied and returns their buffers to the pools (caller holds the
+  // mutex).
+  void commitRefits(std::span<Resolved> resolved,
+                    std::vector<std::pair<uint64_t, std::string>>& refused);
 
   void run();
   void runSetup(std::unique_lock<std::mutex>& lock, uint64_t id, std::shared_ptr<Target> target);

@@ -34,8 +34,12 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
   // The members as the exact source sees them (meshes and shapes; device targets have no CPU
   // mesh and are not kept out), looked up under the lock and read outside it: only this thread
   // touches a target's distance structure.
+  // A mesh the app deformed since is refit first, as a grasp job would: the hand is kept out of
+  // the shape the app last wrote, not the one a grab last built.
   std::vector<std::shared_ptr<Target>> keep;
   std::vector<SceneMember> scene;
+  std::vector<uint64_t> versions;  // scene[k]'s vertex version
+  std::vector<Resolved> refits;
   for (const JobMember& m : job.members) {
     if (m.target == job.attached) continue;
     auto it = targets_.find(m.target);
@@ -44,6 +48,8 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
     if (t.distance == nullptr && !t.shape) continue;
     keep.push_back(it->second);
     scene.push_back(sceneMember(m, t));
+    if (t.positions && t.distance != nullptr) refits.push_back(resolve(m.target, it->second));
+    versions.push_back(t.positions ? t.positionsVersion : t.appliedVersion);
     if (scene.size() == kMaxSceneMembers) break;
   }
   std::shared_ptr<Target> attached;
@@ -57,6 +63,8 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
   }
   const uint64_t setupsBefore = setupsDone_;
   lock.unlock();
+  fillSpares(lock, refits);
+  std::vector<std::pair<uint64_t, std::string>> refused;
   auto done = std::make_shared<OuterDone>();
   done->ticket = job.ticket;
   done->setupsBefore = setupsBefore;
@@ -67,6 +75,16 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
     done->radii[size_t(j)] = job.radii[size_t(j)];
   }
   try {
+    if (refit(refits, refused) != Status::ok) {
+      // A target being dropped: the job goes on without it.
+      for (size_t k = 0; k < scene.size(); ++k) {
+        if (!keep[k]->stop.load(std::memory_order_relaxed)) continue;
+        scene.erase(scene.begin() + std::ptrdiff_t(k));
+        versions.erase(versions.begin() + std::ptrdiff_t(k));
+        keep.erase(keep.begin() + std::ptrdiff_t(k));
+        --k;
+      }
+    }
     if (reset && o.hand != nullptr) o.hand->reset();
     if (o.hand == nullptr)
       o.hand = std::make_unique<OuterHand>(job.model, job.options);
@@ -98,14 +116,16 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
     in.attached = parts;
     in.rigidFingers = job.rigidFingers;
     in.drawnOffset = job.drawnOffset;
-    // A target that moved since the last job may now be in the hand shown then. (One that only
-    // came within reach did not: the hand's own motion brought it.)
-    std::vector<std::pair<uint64_t, Pose>> now;
-    for (const SceneMember& m : scene) now.emplace_back(m.id, m.objectFromHand);
-    in.sceneMoved = std::any_of(now.begin(), now.end(), [&](const auto& m) {
-      return std::any_of(o.lastScene.begin(), o.lastScene.end(), [&](const auto& was) {
-        return was.first == m.first && (was.second.position != m.second.position ||
-                                        was.second.orientation != m.second.orientation);
+    // A target that moved, or that the app deformed, since the last job may now be in the hand
+    // shown then. (One that only came within reach did not: the hand's own motion brought it.)
+    std::vector<OuterSlot::Seen> now;
+    for (size_t k = 0; k < scene.size(); ++k)
+      now.push_back({scene[k].id, scene[k].objectFromHand, versions[k]});
+    in.sceneMoved = std::any_of(now.begin(), now.end(), [&](const OuterSlot::Seen& m) {
+      return std::any_of(o.lastScene.begin(), o.lastScene.end(), [&](const OuterSlot::Seen& was) {
+        return was.id == m.id && (was.objectFromHand.position != m.objectFromHand.position ||
+                                  was.objectFromHand.orientation != m.objectFromHand.orientation ||
+                                  was.version != m.version);
       });
     });
     o.lastScene = std::move(now);
@@ -120,9 +140,13 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
   } catch (...) {
     done->status = Status::internal;
   }
-  keep.clear();
-  attached.reset();
   o.mailbox->latest.store(std::move(done));
+  lock.lock();
+  commitRefits(refits, refused);
+  lock.unlock();
+  keep.clear();  // a target's last reference may go here, outside the lock as before
+  refits.clear();
+  attached.reset();
   lock.lock();
 }
 

@@ -93,42 +93,14 @@ void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job jo
   for (const JobMember& m : job.members) s.runningTargets.push_back(m.target);
   stopBuild_[slot].store(false, std::memory_order_relaxed);
   // Each member's target as it is now, with new positions to apply before the build.
-  struct Resolved {
-    std::shared_ptr<Target> target;  // null: removed, or not set up
-    std::optional<std::vector<glm::vec3>> positions;
-    uint64_t version = 0;
-    size_t missingSpares = 0;
-    std::optional<Aabb> refitBounds;
-  };
   std::vector<Resolved> resolved(job.members.size());
   for (size_t i = 0; i < job.members.size(); ++i) {
     auto it = targets_.find(job.members[i].target);
     if (it == targets_.end() || it->second->setup != TargetSetup::ready) continue;
-    Resolved& r = resolved[i];
-    r.target = it->second;
-    r.positions = std::move(r.target->positions);
-    r.target->positions.reset();
-    r.version = r.positions ? r.target->positionsVersion : r.target->appliedVersion;
-    // A deforming target: fill its pool of buffers here, off the app's thread.
-    if (r.positions && r.target->spares.size() < kMinSpares)
-      r.missingSpares = kMinSpares - r.target->spares.size();
+    resolved[i] = resolve(job.members[i].target, it->second);
   }
   lock.unlock();
-  for (Resolved& r : resolved) {
-    if (r.missingSpares == 0) continue;
-    std::vector<std::vector<glm::vec3>> newSpares;
-    try {
-      for (size_t i = 0; i < r.missingSpares; ++i) newSpares.emplace_back(r.positions->size());
-    } catch (const std::bad_alloc&) {
-      newSpares.clear();  // the app's thread allocates then, as without a pool
-    }
-    // Handed over now, not after the job: a refit and build of a large mesh outlast a frame or
-    // two, and the app's next updates must find a buffer meanwhile (else one allocates and
-    // faults in its pages on the app's thread: 5.7 ms once for 200k vertices).
-    lock.lock();
-    keepSpares(*r.target, newSpares);
-    lock.unlock();
-  }
+  fillSpares(lock, resolved);
 
   const auto start = std::chrono::steady_clock::now();
   Done done;
@@ -139,27 +111,7 @@ void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job jo
   std::vector<std::pair<uint64_t, std::string>> refused;  // the first of each run of refusals
   try {
     if (job.members.empty()) done.status = Status::invalid_argument;
-    // Deformed meshes: refit each hierarchy (O(n)). Positions that collapse a triangle are
-    // refused by updatePositions, which leaves the last shape whole: the hand goes on with it.
-    for (size_t i = 0; i < resolved.size() && done.status == Status::ok; ++i) {
-      Resolved& r = resolved[i];
-      if (r.target == nullptr || r.target->distance == nullptr || !r.positions) continue;
-      const Status refit = r.target->distance->updatePositions(
-          *r.positions, WorkLimit{WorkLimit::Clock::time_point::max(), &r.target->stop});
-      if (refit == Status::ok) {
-        r.refitBounds = computeBounds(*r.positions);
-        r.target->lastUpdateRefused = false;
-      } else if (refit == Status::timed_out) {
-        // The target is being dropped (removed, or the worker destroyed): the half-refit object
-        // goes with it; nothing is built on it.
-        done.status = Status::timed_out;
-      } else if (!r.target->lastUpdateRefused) {
-        r.target->lastUpdateRefused = true;
-        auto why = findDegenerateTriangle(*r.positions, r.target->distance->mesh().indices);
-        refused.emplace_back(job.members[i].target,
-                             why ? why->message : std::string("the positions were refused"));
-      }
-    }
+    if (done.status == Status::ok) done.status = refit(resolved, refused);
     // The scene as the CPU sees it: every member with a mesh or a shape.
     std::vector<SceneMember> scene;
     std::vector<size_t> sceneIndex;  // scene[k] is job.members[sceneIndex[k]]
@@ -257,14 +209,7 @@ void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job jo
 
   lock.lock();
   ++jobsDone_;
-  for (auto& r : refused) refusedUpdates_.push_back(std::move(r));
-  for (Resolved& r : resolved) {
-    if (r.target == nullptr || !r.positions) continue;
-    r.target->appliedVersion = r.version;
-    if (r.refitBounds) r.target->bounds = *r.refitBounds;
-    // The app's next updates fill these again.
-    r.target->spares.push_back(std::move(*r.positions));
-  }
+  commitRefits(resolved, refused);
   s.running = false;
   s.runningTargets.clear();
   if (done.ticket >= s.cancelledBelow) s.done = std::move(done);

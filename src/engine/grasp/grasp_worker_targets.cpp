@@ -177,4 +177,72 @@ void GraspWorker::runSetup(std::unique_lock<std::mutex>& lock, uint64_t id,
   }
 }
 
+GraspWorker::Resolved GraspWorker::resolve(uint64_t id, std::shared_ptr<Target> target) {
+  Resolved r;
+  r.id = id;
+  r.target = std::move(target);
+  r.positions = std::move(r.target->positions);
+  r.target->positions.reset();
+  r.version = r.positions ? r.target->positionsVersion : r.target->appliedVersion;
+  // A deforming target: its pool of buffers is filled by the job, off the app's thread.
+  if (r.positions && r.target->spares.size() < kMinSpares)
+    r.missingSpares = kMinSpares - r.target->spares.size();
+  return r;
+}
+
+void GraspWorker::fillSpares(std::unique_lock<std::mutex>& lock, std::span<Resolved> resolved) {
+  for (Resolved& r : resolved) {
+    if (r.missingSpares == 0) continue;
+    std::vector<std::vector<glm::vec3>> newSpares;
+    try {
+      for (size_t i = 0; i < r.missingSpares; ++i) newSpares.emplace_back(r.positions->size());
+    } catch (const std::bad_alloc&) {
+      newSpares.clear();  // the app's thread allocates then, as without a pool
+    }
+    // Handed over now, not after the job: a refit and build of a large mesh outlast a frame or
+    // two, and the app's next updates must find a buffer meanwhile (else one allocates and
+    // faults in its pages on the app's thread: 5.7 ms once for 200k vertices).
+    lock.lock();
+    keepSpares(*r.target, newSpares);
+    lock.unlock();
+  }
+}
+
+Status GraspWorker::refit(std::span<Resolved> resolved,
+                          std::vector<std::pair<uint64_t, std::string>>& refused) {
+  // Deformed meshes: refit each hierarchy (O(n)). Positions that collapse a triangle are
+  // refused by updatePositions, which leaves the last shape whole: the hand goes on with it.
+  for (Resolved& r : resolved) {
+    if (r.target == nullptr || r.target->distance == nullptr || !r.positions) continue;
+    const Status s = r.target->distance->updatePositions(
+        *r.positions, WorkLimit{WorkLimit::Clock::time_point::max(), &r.target->stop});
+    if (s == Status::ok) {
+      r.refitBounds = computeBounds(*r.positions);
+      r.target->lastUpdateRefused = false;
+    } else if (s == Status::timed_out) {
+      // The target is being dropped (removed, or the worker destroyed): the half-refit object
+      // goes with it; nothing is built on it.
+      return Status::timed_out;
+    } else if (!r.target->lastUpdateRefused) {
+      r.target->lastUpdateRefused = true;
+      auto why = findDegenerateTriangle(*r.positions, r.target->distance->mesh().indices);
+      refused.emplace_back(r.id, why ? why->message : std::string("the positions were refused"));
+    }
+  }
+  return Status::ok;
+}
+
+void GraspWorker::commitRefits(std::span<Resolved> resolved,
+                               std::vector<std::pair<uint64_t, std::string>>& refused) {
+  for (auto& r : refused) refusedUpdates_.push_back(std::move(r));
+  refused.clear();
+  for (Resolved& r : resolved) {
+    if (r.target == nullptr || !r.positions) continue;
+    r.target->appliedVersion = r.version;
+    if (r.refitBounds) r.target->bounds = *r.refitBounds;
+    // The app's next updates fill these again.
+    r.target->spares.push_back(std::move(*r.positions));
+  }
+}
+
 }  // namespace sdfg

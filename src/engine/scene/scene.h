@@ -1,6 +1,7 @@
 // The solids a grasp sees in its grab box: every registered target whose bounds overlap the box
-// (the broad phase, scene_index.h), each as its exact distance (a mesh's MeshDistance or an
-// analytic shape) placed relative to the hand. The field a grasp solves on is their union
+// (the broad phase, scene_index.h), each as its distance source (a mesh's exact MeshDistance, an
+// analytic shape, or a sampled DistanceVolume such as the depth scene's) placed relative to the
+// hand. The field a grasp solves on is their union
 // (scene_field.h), its exact check samples the nearest of them (grasp/scene_exact_source.h), and
 // which one a finger touches decides what the hand holds (grasp/target_choice.h).
 #pragma once
@@ -11,6 +12,7 @@
 #include "base/pose.h"
 #include "mesh/mesh_distance.h"
 #include "scene/analytic_shape.h"
+#include "scene/distance_volume.h"
 
 namespace sdfg {
 
@@ -23,8 +25,9 @@ enum class TargetRole : uint8_t {
 
 struct SceneMember {
   uint64_t id = 0;                     // the target's id
-  const MeshDistance* mesh = nullptr;  // exactly one of mesh and shape is set
+  const MeshDistance* mesh = nullptr;  // exactly one of mesh, shape and volume is set
   const AnalyticShape* shape = nullptr;
+  const DistanceVolume* volume = nullptr;
   Pose objectFromHand;     // hand-space point -> the member's own frame
   bool graspable = false;  // the hand of this grasp may take it (role and per-hand settings)
 };

@@ -20,6 +20,22 @@ void mergeShapeIntoField(const AnalyticShape& shape, const Pose& objectFromHand,
   }
 }
 
+void mergeVolumeIntoField(const DistanceVolume& volume, const Pose& objectFromHand,
+                          SdfGrid& field) {
+  const GridBox& box = field.box();
+  const Pose objectFromBox = objectFromHand * box.handFromBox;
+  std::span<float> values = field.values();
+  for (uint32_t k = 0; k < box.resolution.z; ++k) {
+    for (uint32_t j = 0; j < box.resolution.y; ++j) {
+      for (uint32_t i = 0; i < box.resolution.x; ++i) {
+        const glm::vec3 p = objectFromBox.transformPoint(box.nodeLocal(i, j, k));
+        float& v = values[field.index(i, j, k)];
+        v = std::min(v, volume.signedDistance(p));
+      }
+    }
+  }
+}
+
 Status buildSceneField(std::span<const SceneMember> members, const GridBox& box,
                        SdfBackend& backend, SdfGrid& out, SdfGrid& scratch,
                        const WorkLimit& limit) {
@@ -46,9 +62,12 @@ Status buildSceneField(std::span<const SceneMember> members, const GridBox& box,
     std::fill(out.values().begin(), out.values().end(), std::numeric_limits<float>::infinity());
   }
   for (const SceneMember& m : members) {
-    if (m.shape == nullptr) continue;
+    if (m.shape == nullptr && m.volume == nullptr) continue;
     if (limit.reached()) return Status::timed_out;
-    mergeShapeIntoField(*m.shape, m.objectFromHand, out);
+    if (m.shape != nullptr)
+      mergeShapeIntoField(*m.shape, m.objectFromHand, out);
+    else
+      mergeVolumeIntoField(*m.volume, m.objectFromHand, out);
   }
   out.setExactBand(band);
   return Status::ok;

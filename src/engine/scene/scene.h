@@ -27,9 +27,9 @@ struct SceneMember {
   uint64_t id = 0;                     // the target's id
   const MeshDistance* mesh = nullptr;  // exactly one of mesh, shape and volume is set
   const AnalyticShape* shape = nullptr;
-  const DistanceVolume* volume = nullptr;
   Pose objectFromHand;     // hand-space point -> the member's own frame
   bool graspable = false;  // the hand of this grasp may take it (role and per-hand settings)
+  const DistanceVolume* volume = nullptr;  // a sampled solid (the depth scene's)
 };
 
 // At most this many members take part in one grasp: more targets than this in one grab box are

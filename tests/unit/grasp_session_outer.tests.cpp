@@ -359,3 +359,68 @@ TEST_CASE("Session outer hand: a mesh the app deforms into a still open hand pus
   CHECK(trackedDeepest > 0.003f);  // the top ends 4 mm into the tracked hand
   CHECK(deepest <= 0.001f);
 }
+
+TEST_CASE("Session outer hand: a table rising into a still open hand, paced and drawn at once",
+          "[core][outer_hand]") {
+  // As an app draws: right after each update, whatever the worker has answered by then. The table
+  // top rises at 0.3, 1 and 2 m/s from 6 cm under the hand to 6 cm past where it touched it.
+  const float speed = GENERATE(0.3f, 1.0f, 2.0f);
+  CAPTURE(speed);
+  Rig rig;
+  rig.paced = true;
+  rig.addShape(1, kTable, kWorldFromTable);
+  const float wristY = touchHeight(rig) + 0.06f;
+  std::vector<float> depths;
+  const int frames = int(0.12f / (speed / 90.0f)) + 30;  // the rise, then still
+  for (int k = 0; k <= frames; ++k) {
+    const float rise = std::min(0.12f, speed / 90.0f * float(k));
+    const Pose worldFromTable = at(glm::vec3(0.0f, -0.02f + rise, 0.0f));
+    rig.targets[0].worldFromObject = worldFromTable;
+    const JointPoses drawn = rig.frame(at(glm::vec3(0.0f, wristY, 0.0f)));
+    depths.push_back(depthIn(drawn, rig.radii, kTable, worldFromTable));
+  }
+  std::sort(depths.begin(), depths.end());
+  const float p99 = depths[size_t(0.99 * double(depths.size() - 1))];
+  std::printf(
+      "table rising at %.1f m/s into a still hand, drawn at once: shown hand p99 %.2f mm, "
+      "max %.2f mm inside\n",
+      speed, 1000.0f * p99, 1000.0f * depths.back());
+  CHECK(p99 <= 0.001f);
+  CHECK(depths.back() <= 0.002f);
+}
+
+TEST_CASE("Session outer hand: ten objects moving past a still hand at 1.5 m/s, drawn at once",
+          "[core][outer_hand]") {
+  // Smooth locomotion: the app moves its world past the user, every target each frame. Ten 4 cm
+  // boxes 12 cm apart pass under a still open hand at 1.5 m/s (16.7 mm a frame), their tops 1 cm
+  // above where the hand's lowest part is: each pushes the hand up and out of its way.
+  Rig rig;
+  rig.paced = true;
+  const AnalyticShape box{ShapeKind::box, glm::vec3(0.02f)};
+  const float wristY = touchHeight(rig);  // the hand's lowest part at y = 0
+  const float topY = 0.01f;
+  for (int b = 0; b < 10; ++b)
+    rig.addShape(uint64_t(b + 1), box, at(glm::vec3(-0.3f - 0.12f * float(b), topY - 0.02f, 0.0f)));
+  const float step = 1.5f / 90.0f;
+  std::vector<float> depths;
+  const int frames = int((0.3f + 0.12f * 10.0f + 0.3f) / step);
+  for (int k = 0; k <= frames; ++k) {
+    for (int b = 0; b < 10; ++b)
+      rig.targets[size_t(b)].worldFromObject =
+          at(glm::vec3(-0.3f - 0.12f * float(b) + step * float(k), topY - 0.02f, 0.0f));
+    const JointPoses drawn = rig.frame(at(glm::vec3(0.0f, wristY, 0.0f)));
+    float deepest = -1.0f;
+    for (int b = 0; b < 10; ++b)
+      deepest =
+          std::max(deepest, depthIn(drawn, rig.radii, box, rig.targets[size_t(b)].worldFromObject));
+    depths.push_back(deepest);
+  }
+  std::sort(depths.begin(), depths.end());
+  const float p99 = depths[size_t(0.99 * double(depths.size() - 1))];
+  std::printf(
+      "ten boxes past a still hand at 1.5 m/s, drawn at once: shown hand p99 %.2f mm, max "
+      "%.2f mm inside\n",
+      1000.0f * p99, 1000.0f * depths.back());
+  CHECK(p99 <= 0.001f);
+  CHECK(depths.back() <= 0.002f);
+}

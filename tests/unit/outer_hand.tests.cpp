@@ -288,7 +288,11 @@ TEST_CASE("A curled hand swiped at 2 m/s into a 3 mm plate stays on its side",
 TEST_CASE("A target that moves into a still hand pushes the shown hand out of its way",
           "[core][outer_hand]") {
   // The world moves, not the hand: a table top rising into it (locomotion down a slope, a lift),
-  // and a box brought to it sideways (an object handed over), 3.3 mm a frame (0.3 m/s at 90 Hz).
+  // and a box brought to it sideways (an object handed over), at 0.3, 1 and 2 m/s (3.3, 11.1 and
+  // 22.2 mm a frame at 90 Hz).
+  const float speed = GENERATE(0.3f, 1.0f, 2.0f);
+  CAPTURE(speed);
+  const float perFrame = speed / 90.0f;
   TestHand h;
   const float touchHeight = -h.lowest();
   const glm::vec3 wrist(0.0f, touchHeight + 0.01f, 0.0f);  // 1 cm above where it touches y = 0
@@ -302,9 +306,9 @@ TEST_CASE("A target that moves into a still hand pushes the shown hand out of it
   OuterHandResult r;
   bool pushed = false;
   for (int frame = 0; frame < 30; ++frame) {
-    const float travel = 0.0033f * float(frame);
-    // The table's top from 1 cm under the hand to 9 cm into it; the box from 12 cm beside the
-    // palm (along +x) to 2 cm past it.
+    // The table's top from 1 cm under the hand up to 9 cm into it; the box from 12 cm beside the
+    // palm (along +x) to 2 cm past it; then still.
+    const float travel = std::min(0.1f, perFrame * float(frame));
     const Pose worldFromShape = rising ? at(glm::vec3(0.0f, -0.02f + travel, 0.0f))
                                        : at(glm::vec3(0.12f - travel, touchHeight - 0.02f, 0.0f));
     const std::vector<SceneMember> members{{1, nullptr, &shape, worldFromShape.inverse()}};
@@ -437,4 +441,35 @@ TEST_CASE("After a release the shown hand never follows tracking into another ob
   CHECK_FALSE(r.released);
   CHECK(r.constrained);
   CHECK(r.worldFromShownWrist.position.x < trackedX - 0.005f);
+}
+
+TEST_CASE("A thin plate moving through a still open hand at 2 m/s pushes it, never through",
+          "[core][outer_hand]") {
+  // A 3 mm plate (a tray, a door) swept up through where the hand is, 22 mm a frame, from 2 cm
+  // under it to 4 cm past where it would have cut through the palm.
+  TestHand h;
+  const float touchHeight = -h.lowest();
+  const glm::vec3 wrist(0.0f, touchHeight + 0.02f, 0.0f);
+  const AnalyticShape plate{ShapeKind::box, glm::vec3(0.2f, 0.0015f, 0.2f)};
+  OuterHand outer(h.model);
+  float deepest = 0.0f, lowestWrist = 1.0f;
+  for (int frame = 0; frame < 20; ++frame) {
+    const float y = std::min(0.0015f + 0.0222f * float(frame), touchHeight + 0.06f);
+    const Pose worldFromPlate = at(glm::vec3(0.0f, y, 0.0f));
+    const std::vector<SceneMember> members{{1, nullptr, &plate, worldFromPlate.inverse()}};
+    const SceneExactSource scene(members);
+    OuterHandInput in;
+    in.worldFromWrist = at(wrist);
+    in.joints = &h.joints;
+    in.radii = &h.radii;
+    in.time = frame * kFrame;
+    in.sceneMoved = true;
+    const auto result = outer.update(in, &scene);
+    REQUIRE(result.ok());
+    deepest = std::min(deepest, shownClearance(h, *result, plate, worldFromPlate));
+    // The shown wrist, relative to the plate: never on its far side.
+    lowestWrist = std::min(lowestWrist, result->worldFromShownWrist.position.y - y);
+  }
+  CHECK(deepest >= -0.001f);
+  CHECK(lowestWrist > 0.0f);
 }

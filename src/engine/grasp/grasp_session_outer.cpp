@@ -137,10 +137,13 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
             motion, glm::length(frame.worldFromWrist.position - latest->trackedWrist.position) +
                         angleOf(turn.orientation) * latest->attachedReach);
       }
-      clear = motion + settings_.outerOptions.margin < r.clearance;
+      // The targets move too: as far as they moved in the frame before (the worker's estimate).
+      clear = motion + latest->sceneMotion + settings_.outerOptions.margin < r.clearance;
     }
     if (!clear) {
-      view.fallback.offset = frame.worldFromWrist.inverse() * r.worldFromShownWrist;
+      // Where that result's hand must be to be out of the scene as it is now, with its moving
+      // targets moved on (the same motion again): not one frame of their motion inside them.
+      view.fallback.offset = frame.worldFromWrist.inverse() * latest->predictedShownWrist;
       view.fallback.capped = r.capped;
       view.fallback.curl = r.curl;
       view.fallback.changes = true;

@@ -192,6 +192,13 @@ class GraspWorker {
     // Set-ups the worker had finished when it started the job (cumulative, as setupsDone()):
     // shows that a queued set-up did not delay it.
     uint64_t setupsBefore = 0;
+    // A frame on: where the shown wrist must be to be out of the scene with its moving targets
+    // moved on as they moved since the job before (the same motion again), and how far a part of
+    // a moving target moves in that frame (0: nothing moved). What the session shows while the
+    // next answer is late (an app draws before the worker answers its frame): the hand is not
+    // left one frame of a target's motion inside it.
+    Pose predictedShownWrist;
+    float sceneMotion = 0.0f;
   };
   // The newest finished outer-hand result of a slot, published by the worker and read from any
   // thread without waiting for the worker's work (the layer's xrLocateHandJointsEXT draws with a

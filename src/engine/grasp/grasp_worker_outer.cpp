@@ -39,6 +39,7 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
   std::vector<std::shared_ptr<Target>> keep;
   std::vector<SceneMember> scene;
   std::vector<uint64_t> versions;  // scene[k]'s vertex version
+  std::vector<float> reaches;      // scene[k]'s farthest point from its origin (object frame)
   std::vector<Resolved> refits;
   for (const JobMember& m : job.members) {
     if (m.target == job.attached) continue;
@@ -50,6 +51,9 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
     scene.push_back(sceneMember(m, t));
     if (t.positions && t.distance != nullptr) refits.push_back(resolve(m.target, it->second));
     versions.push_back(t.positions ? t.positionsVersion : t.appliedVersion);
+    reaches.push_back(t.shape && !t.shape->bounded()
+                          ? 0.0f
+                          : std::max(glm::length(t.bounds.min), glm::length(t.bounds.max)));
     if (scene.size() == kMaxSceneMembers) break;
   }
   std::shared_ptr<Target> attached;
@@ -81,6 +85,7 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
         if (!keep[k]->stop.load(std::memory_order_relaxed)) continue;
         scene.erase(scene.begin() + std::ptrdiff_t(k));
         versions.erase(versions.begin() + std::ptrdiff_t(k));
+        reaches.erase(reaches.begin() + std::ptrdiff_t(k));
         keep.erase(keep.begin() + std::ptrdiff_t(k));
         --k;
       }
@@ -128,13 +133,40 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
                                   was.version != m.version);
       });
     });
+    // The scene a frame on: each member that moved since the last job moved on by the same
+    // rigid motion (objectFromHand maps world points: a = W^-1, so W_next = W W_prev^-1 W).
+    std::vector<SceneMember> next = scene;
+    bool moving = false;
+    for (size_t k = 0; k < scene.size(); ++k) {
+      for (const OuterSlot::Seen& was : o.lastScene) {
+        if (was.id != scene[k].id) continue;
+        const Pose worldNow = scene[k].objectFromHand.inverse();
+        const Pose step = worldNow * was.objectFromHand;  // W_now W_prev^-1
+        const float turn = 2.0f * std::acos(std::min(1.0f, std::abs(step.orientation.w)));
+        const float travel =
+            glm::length(step.transformPoint(worldNow.position) - worldNow.position);
+        if (travel == 0.0f && turn == 0.0f) break;
+        moving = true;
+        next[k].objectFromHand = (step * worldNow).inverse();
+        // An unbounded shape (a plane) turning sweeps without bound: counted by its travel.
+        done->sceneMotion = std::max(done->sceneMotion, travel + turn * reaches[k]);
+        break;
+      }
+    }
     o.lastScene = std::move(now);
     const SceneExactSource source(scene);
     auto r = o.hand->update(in, scene.empty() ? nullptr : &source);
-    if (r)
+    if (r) {
       done->result = *r;
-    else
+      done->predictedShownWrist = r->worldFromShownWrist;
+      if (moving) {
+        const SceneExactSource ahead(next);
+        if (auto c = o.hand->pushOutOf(ahead))
+          done->predictedShownWrist = *c * r->worldFromShownWrist;
+      }
+    } else {
       done->status = r.error().code;
+    }
   } catch (const std::bad_alloc&) {
     done->status = Status::out_of_memory;
   } catch (...) {

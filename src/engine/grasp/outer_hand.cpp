@@ -298,6 +298,19 @@ std::optional<Pose> pushOut(std::span<const glm::vec3> world, std::span<const fl
 
 }  // namespace
 
+std::optional<Pose> OuterHand::pushOutOf(const ExactDistanceSource& scene) const {
+  if (!engaged_ || shownRigid_.empty()) return std::nullopt;
+  std::vector<glm::vec3> world;
+  glm::vec3 centre(0.0f);
+  for (const glm::vec3& p : shownRigid_) {
+    world.push_back(shown_.transformPoint(p));
+    centre += world.back();
+  }
+  centre /= float(world.size());
+  int samples = 0;
+  return pushOut(world, shownRigidRadius_, centre, scene, options_, samples);
+}
+
 std::vector<HandPart> surfaceParts(const TriangleMesh& mesh) {
   std::vector<HandPart> out;
   const size_t triangles = mesh.triangleCount();

@@ -121,6 +121,11 @@ class OuterHand {
   void setModel(const HandModel& model);
   void setOptions(const OuterHandOptions& options) { options_ = options; }
   const HandModel& model() const { return model_; }
+  // The smallest rigid motion (world, applied after the shown pose) that takes the hand shown last
+  // (its rigid parts) out of `scene`, e.g. the scene a frame on with its moving targets where
+  // their motion takes them; nothing when it is out already, nothing was shown, or no clear pose
+  // is within the release distance.
+  std::optional<Pose> pushOutOf(const ExactDistanceSource& scene) const;
 
  private:
   struct FingerRig {

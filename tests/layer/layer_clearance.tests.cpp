@@ -65,10 +65,13 @@ struct Neighbour {
   XrPosef pose;
 };
 
+// The outer hand is off: this is the grasp's own clearance (with it on, a hand that appears inside
+// is shown at the nearest clear pose before any squeeze: layer_outer_hand.tests.cpp).
 void grabFromInside(const TestMesh& mesh, const XrPosef& pose, const XrPosef& grip,
                     const Neighbour* neighbour = nullptr) {
   XrEnv env;
   env.handTracking = "absent";
+  env.extra = {{"SDFG_AUTOGRASP_OUTER_HAND", "false"}};
   env.script =
       gripLine(0, "right", grip) + squeezeLine(0, "right", 0.0f) + squeezeLine(6, "right", 1.0f);
   applyEnv(env);
@@ -186,6 +189,7 @@ TEST_CASE("A tracked hand squeezed through the thin plate is moved out whole, ne
   // The mock runtime's tracked hand is flat and open (the user's curl 0), its wrist at the grip.
   const XrPosef grip{{0, 0, 0, 1}, {0.2f, -0.3f, -0.4f}};
   XrEnv env;
+  env.extra = {{"SDFG_AUTOGRASP_OUTER_HAND", "false"}};  // the grasp's own clearance
   env.script =
       gripLine(0, "right", grip) + squeezeLine(0, "right", 0.0f) + squeezeLine(6, "right", 1.0f);
   applyEnv(env);

@@ -407,11 +407,14 @@ void readHand(App& app, const Ext& ext, XrHandTrackerEXT tracker, Grab& g) {
 // The right hand at kGrip squeezes (from frame 6) on `mesh` at `pose`; frames run until it
 // grasps with its offset fully blended in, for at most `limit` of wall time (a bound, not a frame
 // count: the layer sets up and solves on its session's worker, as fast as the machine allows). The
-// set-up is waited for first without frames, so the scripted squeeze waits for it too.
+// set-up is waited for first without frames, so the scripted squeeze waits for it too. The outer
+// hand is off: these cases measure the grasp's own clearance of a hand placed inside the mesh (the
+// outer hand would show that hand at the nearest clear pose before the squeeze).
 Grab grab(const TestMesh& mesh, const XrPosef& pose,
           std::chrono::milliseconds limit = std::chrono::seconds(45)) {
   XrEnv env;
   env.handTracking = "absent";
+  env.extra = {{"SDFG_AUTOGRASP_OUTER_HAND", "false"}};
   env.script =
       gripLine(0, "right", kGrip) + squeezeLine(0, "right", 0.0f) + squeezeLine(6, "right", 1.0f);
   applyEnv(env);

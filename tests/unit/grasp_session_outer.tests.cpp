@@ -424,3 +424,54 @@ TEST_CASE("Session outer hand: ten objects moving past a still hand at 1.5 m/s, 
   CHECK(p99 <= 0.001f);
   CHECK(depths.back() <= 0.002f);
 }
+
+TEST_CASE("Session outer hand: tracking lost for 20 frames and found inside a box is shown clear",
+          "[core][outer_hand]") {
+  // Paced at 90 Hz and drawn at once. The hand near a box, then 20 frames without tracking, then
+  // found 1 cm into the box's top. The frame it is found is drawn before any answer for it (the
+  // tracked pose: a hand can only be known clear by the worker); from the next frame on it is
+  // shown at the nearest clear pose.
+  Rig rig;
+  rig.paced = true;
+  const AnalyticShape box{ShapeKind::box, glm::vec3(0.05f)};
+  const float touch = touchHeight(rig);
+  rig.addShape(1, box, at(glm::vec3(0.0f, -0.04f, 0.0f)), TargetRole::graspable);  // top y = 1 cm
+  for (int k = 0; k < 10; ++k) rig.frame(at(glm::vec3(0.0f, touch + 0.04f, 0.0f)));
+  for (int k = 0; k < 20; ++k) {
+    HandFrame lost;  // not valid: tracking lost
+    lost.time = rig.time;
+    rig.time += kFrameNs;
+    REQUIRE(rig.session.update(Hand::right, lost, std::span<const TargetFrame>(rig.targets)) ==
+            Status::ok);
+  }
+  const Pose inside = at(glm::vec3(0.0f, touch, 0.0f));
+  std::vector<float> depths;
+  for (int k = 0; k < 30; ++k) {
+    const JointPoses drawn = rig.frame(inside);
+    if (k > 0) depths.push_back(depthIn(drawn, rig.radii, box, rig.targets[0].worldFromObject));
+  }
+  const float deepest = *std::max_element(depths.begin(), depths.end());
+  std::printf(
+      "found 1 cm inside a box after 20 frames lost: from the next frame on at most %.2f mm "
+      "inside\n",
+      1000.0f * deepest);
+  CHECK(deepest <= 0.001f);
+  // And squeezed there, the hand that closes is out of the box too.
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  JointPoses drawn{};
+  while (std::chrono::steady_clock::now() < deadline) {
+    drawn = rig.frame(inside, 1.0f);
+    if (rig.session.grasp(Hand::right).shown()) break;
+  }
+  REQUIRE(rig.session.grasp(Hand::right).shown());
+  // Holding the box it is the grasp that keeps the hand out (the outer hand leaves a held target
+  // to it): the open hand it closed moved out by its correction, which the layer draws the whole
+  // hand with (hand_offset_blend.h; this rig draws no grasp offset, so it is applied here).
+  const HandGrasp& g = rig.session.grasp(Hand::right);
+  CHECK_FALSE(g.result.clearanceExceeded);
+  const Pose worldFromCorrected = inside * g.result.handCorrection;
+  JointPoses corrected;
+  for (int j = 0; j < kJointCount; ++j)
+    corrected[size_t(j)] = worldFromCorrected * (inside.inverse() * drawn[size_t(j)]);
+  CHECK(depthIn(corrected, rig.radii, box, rig.targets[0].worldFromObject) <= 0.001f);
+}

@@ -473,3 +473,27 @@ TEST_CASE("A thin plate moving through a still open hand at 2 m/s pushes it, nev
   CHECK(deepest >= -0.001f);
   CHECK(lowestWrist > 0.0f);
 }
+
+TEST_CASE("A hand that appears inside a box (its first update) is shown at the nearest clear pose",
+          "[core][outer_hand]") {
+  // Tracking found again, or the first frame near a target: no history, the hand 1 cm into a
+  // box's top. Shown out of it at once, within 2 cm of the tracked pose (the nearest way out).
+  TestHand h;
+  const float touchHeight = -h.lowest();
+  const AnalyticShape box{ShapeKind::box, glm::vec3(0.05f, 0.05f, 0.05f)};
+  const Pose worldFromBox = at(glm::vec3(0.0f, -0.04f, 0.0f));  // its top at y = 0.01
+  const std::vector<SceneMember> members{{1, nullptr, &box, worldFromBox.inverse()}};
+  const SceneExactSource scene(members);
+  OuterHand outer(h.model);
+  Stepper step{outer, h, scene};
+  const glm::vec3 inside(0.0f, touchHeight, 0.0f);
+  const OuterHandResult r = step(inside);
+  CHECK(r.pushedOut);
+  CHECK(shownClearance(h, r, box, worldFromBox) >= -0.001f);
+  CHECK(glm::length(r.worldFromShownWrist.position - inside) < 0.02f);
+  // Held there while tracking stays inside; back to tracking once it is clear.
+  CHECK(shownClearance(h, step(inside), box, worldFromBox) >= -0.001f);
+  const glm::vec3 above(0.0f, touchHeight + 0.05f, 0.0f);
+  const OuterHandResult out = step(above);
+  CHECK(out.worldFromShownWrist.position == above);
+}

@@ -540,9 +540,9 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
     released_ = false;
     for (int f = 0; f < kFingerCount; ++f) curl_[size_t(f)] = user[size_t(f)];
     capped_.fill(false);
-    // A hand that appears inside (its first update) is left to the grasp's clearance, which moves
-    // the open hand out at a grab, and to the release rule; a jump is the outer hand's.
-    if (jumped) {
+    // A hand that appears inside (its first update: tracking found again, the first frame near
+    // a target) is shown at the nearest clear pose as a jump is.
+    {
       std::vector<glm::vec3> handWorld;
       std::vector<float> handRadii;
       for (int i = 0; i < count; ++i) {

@@ -14,7 +14,8 @@ if(NOT rc EQUAL 0)
 endif()
 set(names table_slide plate_push_2ms plate_push_3ms plate_push_5ms mug_slide ring_swipe_2ms
   ring_swipe_3ms ring_swipe_5ms plate_edge_2ms plate_edge_3ms plate_edge_5ms table_near_still
-  table_pressed_still mug_pressed_still)
+  table_pressed_still mug_pressed_still table_rise_03ms table_rise_1ms table_rise_2ms
+  boxes_pass_15ms)
 foreach(name ${names})
   if(NOT out MATCHES "\\| ${name} \\| [0-9]+ \\| [0-9]")
     message(FATAL_ERROR "the table has no row of figures for ${name}:\n${out}")

@@ -47,7 +47,7 @@ using sdfg::tools::jsonNumber;
 
 const char* const kUsage =
     "usage: autograsp-outer [--quick] [--only NAME]... [--wait-worker] [--draw-at MS]\n"
-    "                       [--squeeze S] [--check]\n"
+    "                       [--squeeze S] [--check | --check-penetration]\n"
     "                       [--json FILE [--per-frame]]\n"
     "  --quick        shorter holds and slides (the smoke test); speeds and depths stay\n"
     "  --only NAME    run only the trajectory NAME (repeatable)\n"
@@ -56,11 +56,15 @@ const char* const kUsage =
     "  --squeeze S    the tracked hand's fingers curled by S in [0, 1] (default 0: open)\n"
     "  --check        exit 3 when a trajectory misses a quality target (distance from tracking\n"
     "                 counted outside the outer hand's keep-out)\n"
+    "  --check-penetration  exit 3 when the shown hand goes into anything beyond the targets\n"
+    "                 (penetration p99 1 mm, max 2 mm) or through a thin part: the gate that\n"
+    "                 holds on a busy machine too, paced (a late answer may leave the hand a\n"
+    "                 frame behind tracking, never inside)\n"
     "  --json FILE    write the results as JSON\n"
     "  --per-frame    with --json: every frame's clearances, distances and flags too\n"
     "  --help         this text\n"
     "exit codes: 0 done (and, with --check, every target met); 1 a run failed or the JSON could\n"
-    "not be written; 2 bad option; 3 a target missed (--check)\n";
+    "not be written; 2 bad option; 3 a target missed (--check, --check-penetration)\n";
 
 // Targets of issue 27.
 constexpr double kPenetrationP99Mm = 1.0;
@@ -100,11 +104,18 @@ struct Summary {
   // The issue's targets as stated.
   bool meets() const { return meetsByDesign() && offWhileClearMm == 0.0; }
   // The same with the distance from tracking counted only outside the keep-out (--check).
+  bool keepsOut() const {
+    return ok && penetrationMm.p99 <= kPenetrationP99Mm && penetrationMm.max <= kPenetrationMaxMm &&
+           !passThrough;
+  }
   bool meetsByDesign() const {
     return ok && penetrationMm.p99 <= kPenetrationP99Mm && penetrationMm.max <= kPenetrationMaxMm &&
            offWhileKeepOutMm == 0.0 && jitterSettledMm <= kJitterMm && !passThrough;
   }
 };
+
+// Where targets move: the tracked hand's clearance past which it must be shown exactly (metres).
+constexpr float kMovingClear = 0.01f;
 
 Summary summarize(const Trajectory& t, const RunRecord& on, const RunRecord& off) {
   Summary s;
@@ -128,8 +139,12 @@ Summary summarize(const Trajectory& t, const RunRecord& on, const RunRecord& off
       s.offWhileClearMm = std::max(s.offWhileClearMm, 1000.0 * r.offTracking);
       if (!r.identical) ++s.offWhileClearCount;
       // Clear of the outer hand's keep-out too: the margin, kept on the capsules' cover radii
-      // (about 0.67 mm more than the radii on this hand), is by design.
-      if (r.trackedKeepOut > kClearMargin) {
+      // (about 0.67 mm more than the radii on this hand), is by design. Where the world moves, a
+      // target that just pushed the hand and moved on is still within the keep-out of the next
+      // step: the shown hand comes back over a frame, and only a tracked hand clear by 1 cm (the
+      // issue's gate) must be shown exactly.
+      const float keepOut = t.objectPoses.empty() ? kClearMargin : kMovingClear;
+      if (r.trackedKeepOut > keepOut) {
         ++s.keepOutFrames;
         s.offWhileKeepOutMm = std::max(s.offWhileKeepOutMm, 1000.0 * r.offTracking);
       }
@@ -225,7 +240,7 @@ Json summaryJson(const Summary& s, bool perFrame) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool quick = false, waitWorker = false, check = false, perFrame = false;
+  bool quick = false, waitWorker = false, check = false, checkPenetration = false, perFrame = false;
   float drawAt = 8.0f;
   float squeeze = 0.0f;
   std::string json;
@@ -234,6 +249,7 @@ int main(int argc, char** argv) {
   cli.add_flag("--quick", quick);
   cli.add_flag("--wait-worker", waitWorker);
   cli.add_flag("--check", check);
+  cli.add_flag("--check-penetration", checkPenetration)->excludes("--check");
   cli.add_flag("--per-frame", perFrame);
   sdfg::tools::cli::addNumber(
       cli, "--draw-at", drawAt, [](float v) { return v >= 0.0f && v <= 11.0f; },
@@ -305,7 +321,7 @@ int main(int argc, char** argv) {
       ++failures;
       continue;
     }
-    missed += check ? !s.meetsByDesign() : !s.meets();
+    missed += checkPenetration ? !s.keepsOut() : check ? !s.meetsByDesign() : !s.meets();
     const char* pass = !s.hasPassCheck ? "n/a" : s.passThrough ? "yes" : "no";
     const char* verdict = s.meets()           ? "met"
                           : s.meetsByDesign() ? "missed: off tracking inside the keep-out"
@@ -344,7 +360,7 @@ int main(int argc, char** argv) {
     std::printf("\nwrote %s\n", json.c_str());
   }
   if (failures > 0) return 1;
-  if (check && missed > 0) {
+  if ((check || checkPenetration) && missed > 0) {
     std::printf("%d trajectories missed a target\n", missed);
     return 3;
   }

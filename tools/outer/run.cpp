@@ -72,6 +72,9 @@ RunRecord runTrajectory(const Trajectory& trajectory, const TrackedHand& hand,
   int still = 0;
   Clock::time_point frameStart = Clock::now();
   for (size_t k = 0; k < trajectory.hand.size(); ++k) {
+    const std::vector<SceneObject> objects = trajectory.objectsAt(k);
+    for (size_t i = 0; i < targets.size(); ++i)
+      targets[i].worldFromObject = objects[i].worldFromObject;
     hand.world(trajectory.hand[k], tracked);
     HandFrame frame;
     frame.valid = true;
@@ -110,11 +113,10 @@ RunRecord runTrajectory(const Trajectory& trajectory, const TrackedHand& hand,
     r.drawMs = ms(t3 - t2);
     r.outerActive = view.outer.active;
     r.onTime = view.outer.active && resolveOuter(view.outer).onTime;
-    r.shownClearance = smallestClearance(shown, hand.radii, trajectory.objects);
-    r.trackedClearance = smallestClearance(tracked, hand.radii, trajectory.objects);
-    r.shownPartClearance = smallestPartClearance(shown, hand.radii, trajectory.objects).radius;
-    const PartClearance trackedParts =
-        smallestPartClearance(tracked, hand.radii, trajectory.objects);
+    r.shownClearance = smallestClearance(shown, hand.radii, objects);
+    r.trackedClearance = smallestClearance(tracked, hand.radii, objects);
+    r.shownPartClearance = smallestPartClearance(shown, hand.radii, objects).radius;
+    const PartClearance trackedParts = smallestPartClearance(tracked, hand.radii, objects);
     r.trackedPartClearance = trackedParts.radius;
     r.trackedKeepOut = trackedParts.cover;
     r.identical = true;
@@ -124,7 +126,14 @@ RunRecord runTrajectory(const Trajectory& trajectory, const TrackedHand& hand,
       r.offTracking = std::max(r.offTracking, glm::length(a.position - b.position));
       r.identical = r.identical && samePose(a, b);
     }
+    // Still: the hand and everything near it (a hand pushed by a moving target is meant to move).
     r.trackedStill = k > 0 && samePose(trajectory.hand[k], trajectory.hand[k - 1]);
+    if (r.trackedStill && k < trajectory.objectPoses.size()) {
+      const std::vector<Pose>& now = trajectory.objectPoses[k];
+      const std::vector<Pose>& before = trajectory.objectPoses[k - 1];
+      for (size_t i = 0; i < now.size() && r.trackedStill; ++i)
+        r.trackedStill = samePose(now[i], before[i]);
+    }
     still = r.trackedStill ? still + 1 : 0;
     r.stillFrames = still;
     if (k > 0)

@@ -129,6 +129,14 @@ std::vector<Pose> pressAndHold(const Pose& base, const glm::vec3& dir, float tou
 
 }  // namespace
 
+std::vector<SceneObject> Trajectory::objectsAt(size_t k) const {
+  std::vector<SceneObject> now = objects;
+  if (k < objectPoses.size())
+    for (size_t i = 0; i < now.size() && i < objectPoses[k].size(); ++i)
+      now[i].worldFromObject = objectPoses[k][i];
+  return now;
+}
+
 float SceneObject::signedDistance(const glm::vec3& world) const {
   const glm::vec3 p = worldFromObject.inverse().transformPoint(world);
   return shape ? shape->signedDistance(p) : distance->signedDistance(p);
@@ -299,6 +307,58 @@ std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale) {
     t.objects.push_back(meshObject("mug", 4, makeMug(), Pose{}));
     const float touch = touchOffset(hand, t.objects, besideMug, east, 0.3f);
     t.hand = pressAndHold(besideMug, east, touch, scale);
+    out.push_back(std::move(t));
+  }
+
+  // 6. The world moves, the hand holds still: a table top rising into the open hand at 0.3, 1 and
+  // 2 m/s from 6 cm under it to 6 cm past its touch, then still (a lift, locomotion down a
+  // slope); ten 4 cm boxes 12 cm apart passing under the hand at 1.5 m/s with their tops 1 cm
+  // above its lowest part (smooth locomotion past a shelf).
+  for (float speed : {0.3f, 1.0f, 2.0f}) {
+    Trajectory t;
+    t.name = speed < 1.0f ? "table_rise_03ms" : "table_rise_" + std::to_string(int(speed)) + "ms";
+    t.description = "a table top rising into a still open hand to 6 cm past its touch";
+    t.objects.push_back(table());
+    const float touch = touchOffset(hand, t.objects, overTable, down, 0.3f);
+    const Pose still = moved(overTable, down * (touch - 0.06f));
+    const Pose tableStart = t.objects[0].worldFromObject;
+    const int rise = int(std::ceil(0.12f / (speed * float(kFrameSeconds))));
+    const int frames = rise + int(std::lround(secs(0.5) / kFrameSeconds)) + 10;
+    for (int k = 0; k < frames; ++k) {
+      t.hand.push_back(still);
+      const float up = std::min(0.12f, speed * float(kFrameSeconds) * float(std::max(0, k - 10)));
+      t.objectPoses.push_back({moved(tableStart, -down * up)});
+    }
+    out.push_back(std::move(t));
+  }
+  {
+    Trajectory t;
+    t.name = "boxes_pass_15ms";
+    t.description = "ten 4 cm boxes passing under a still open hand at 1.5 m/s, 1 cm into it";
+    const AnalyticShape box{ShapeKind::box, glm::vec3(0.02f)};
+    // The hand's lowest point over the table, where the boxes' tops are 1 cm above it.
+    std::vector<SceneObject> probe{table()};
+    const float touch = touchOffset(hand, probe, overTable, down, 0.3f);
+    const Pose still = moved(overTable, down * touch);  // its lowest part at y = 0
+    for (int b = 0; b < 10; ++b) {
+      SceneObject o;
+      o.name = "box" + std::to_string(b);
+      o.id = uint64_t(10 + b);
+      o.shape = box;
+      t.objects.push_back(o);
+    }
+    const float step = 1.5f * float(kFrameSeconds);
+    const glm::vec3 palm = still.transformPoint(hand.local[size_t(Joint::palm)].position);
+    const int frames = int((0.3f + 0.12f * 10.0f + 0.3f) / step);
+    for (int k = 0; k < frames; ++k) {
+      t.hand.push_back(still);
+      std::vector<Pose> poses;
+      for (int b = 0; b < 10; ++b)
+        poses.push_back(at(flat, glm::vec3(palm.x - 0.3f - 0.12f * float(b) + step * float(k),
+                                           0.01f - 0.02f, palm.z)));
+      t.objectPoses.push_back(std::move(poses));
+    }
+    for (int b = 0; b < 10; ++b) t.objects[size_t(b)].worldFromObject = t.objectPoses[0][size_t(b)];
     out.push_back(std::move(t));
   }
   return out;

@@ -64,6 +64,11 @@ struct Trajectory {
   std::vector<SceneObject> objects;
   std::vector<Pose> hand;  // worldFromHand per frame
   std::optional<PassCheck> pass;
+  // Objects the app moves: per frame, every object's worldFromObject (empty: each stays where
+  // `objects` places it). The world moving past a still hand: locomotion, an object brought to it.
+  std::vector<std::vector<Pose>> objectPoses;
+  // `objects` as they are at frame k.
+  std::vector<SceneObject> objectsAt(size_t k) const;
 };
 
 // The deepest penetration of joint spheres (world joints, radii) into any object, metres (0 when

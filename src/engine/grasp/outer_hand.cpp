@@ -697,10 +697,21 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
   int slideSamples = 0;
   // The hand tested is the one shown last (its rigid parts then), in the world as it is now: a
   // part the user's own input moves in (a thumb curled into the table) is not the world's doing.
+  // The fingers count as shown last too (at their last shown curls): a table rising into a
+  // relaxed, half-curled hand meets the fingertips first, and the hand rises with it rather than
+  // leave them in it.
   if (in.sceneMoved && !lastRigid.empty()) {
     std::vector<glm::vec3> handWorld;
+    std::vector<float> handRadii = lastRigidRadius;
     for (const glm::vec3& p : lastRigid) handWorld.push_back(shown_.transformPoint(p));
-    if (auto c = pushOut(handWorld, lastRigidRadius, shown_.transformPoint(pivot), *scene, options_,
+    std::vector<glm::vec3> spheres;
+    for (int f = 0; f < kFingerCount && !in.rigidFingers; ++f) {
+      fingerSpheres(f, curl_[size_t(f)], spheres);
+      for (const glm::vec3& p : spheres) handWorld.push_back(shown_.transformPoint(p));
+      handRadii.insert(handRadii.end(), rigs_[size_t(f)].radius.begin(),
+                       rigs_[size_t(f)].radius.end());
+    }
+    if (auto c = pushOut(handWorld, handRadii, shown_.transformPoint(pivot), *scene, options_,
                          slideSamples)) {
       shown_ = *c * shown_;
       out.pushedOut = true;

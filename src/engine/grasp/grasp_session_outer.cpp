@@ -21,6 +21,21 @@ constexpr float kCurlSlack = 0.01f;
 // was then: no more closed.
 constexpr float kFingerStill = 0.0005f;
 
+// A late answer's prediction goes at most this many steps of the targets' motion ahead.
+constexpr double kMaxPredictedSteps = 8.0;
+
+// `step` (a rigid motion) taken `times` times (a fraction: the last time in part).
+Pose repeatedMotion(const Pose& step, double times) {
+  Pose out;
+  const int whole = int(times);
+  for (int i = 0; i < whole; ++i) out = step * out;
+  const float part = float(times - double(whole));
+  if (part > 0.0f)
+    out =
+        Pose{glm::slerp(glm::quat(1, 0, 0, 0), step.orientation, part), step.position * part} * out;
+  return out;
+}
+
 float angleOf(const glm::quat& q) {
   return 2.0f * std::acos(std::min(1.0f, std::abs(q.w)));
 }
@@ -128,6 +143,12 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
   view.fallback = OuterNow{};
   if (fresh) {
     const OuterHandResult& r = latest->result;
+    // How many of the worker's steps this frame is past that answer (a worker late by two frames
+    // is two frames of the targets' motion behind).
+    double steps = 1.0;
+    if (latest->stepInterval > 0.0)
+      steps = std::clamp((double(frame.time) * 1e-9 - latest->jobTime) / latest->stepInterval, 0.0,
+                         kMaxPredictedSteps);
     bool clear = !r.constrained;
     if (clear) {
       float motion = sinceResult;
@@ -137,13 +158,34 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
             motion, glm::length(frame.worldFromWrist.position - latest->trackedWrist.position) +
                         angleOf(turn.orientation) * latest->attachedReach);
       }
-      // The targets move too: as far as they moved in the frame before (the worker's estimate).
-      clear = motion + latest->sceneMotion + settings_.outerOptions.margin < r.clearance;
+      // The targets move too: as far as any moved since that answer (where they are now, against
+      // where the job saw them), or as the worker's estimate of their motion says, the larger.
+      float targetMotion = float(steps) * latest->sceneMotion;
+      for (const GraspWorker::OuterDone::Placed& p : latest->placed) {
+        const std::optional<Pose> now = index_.worldFromObject(p.id);
+        if (!now) continue;
+        const Pose delta = *now * p.worldFromObject.inverse();
+        targetMotion = std::max(targetMotion,
+                                glm::length(now->position - p.worldFromObject.position) +
+                                    angleOf(delta.orientation) * (p.reach > 0.0f ? p.reach : 1.0f));
+      }
+      clear = motion + targetMotion + settings_.outerOptions.margin < r.clearance;
     }
     if (!clear) {
       // Where that result's hand must be to be out of the scene as it is now, with its moving
-      // targets moved on (the same motion again): not one frame of their motion inside them.
-      view.fallback.offset = frame.worldFromWrist.inverse() * latest->predictedShownWrist;
+      // targets moved on as they moved (the same motion again, once per step since the answer):
+      // not their motion since inside them.
+      // The shortest prediction that reaches this frame (a hand pushed a little ahead of a
+      // target is clear; one behind it is inside); past the longest, that one repeated.
+      Pose push = repeatedMotion(latest->predicted.back(),
+                                 steps / double(GraspWorker::OuterDone::kPredictedSteps.back()));
+      for (size_t h = 0; h < latest->predicted.size(); ++h) {
+        if (double(GraspWorker::OuterDone::kPredictedSteps[h]) + 1e-6 >= steps) {
+          push = latest->predicted[h];
+          break;
+        }
+      }
+      view.fallback.offset = frame.worldFromWrist.inverse() * (push * r.worldFromShownWrist);
       view.fallback.capped = r.capped;
       view.fallback.curl = r.curl;
       view.fallback.changes = true;

@@ -192,12 +192,27 @@ class GraspWorker {
     // Set-ups the worker had finished when it started the job (cumulative, as setupsDone()):
     // shows that a queued set-up did not delay it.
     uint64_t setupsBefore = 0;
-    // A frame on: where the shown wrist must be to be out of the scene with its moving targets
-    // moved on as they moved since the job before (the same motion again), and how far a part of
-    // a moving target moves in that frame (0: nothing moved). What the session shows while the
-    // next answer is late (an app draws before the worker answers its frame): the hand is not
-    // left one frame of a target's motion inside it.
-    Pose predictedShownWrist;
+    // One step on (as long as from the job before to this one, `stepInterval` seconds; 0: nothing
+    // moved): the correction (world, applied after the shown wrist) that keeps the shown hand out
+    // of the scene with its moving targets moved on as they moved in the step before, and how far
+    // a part of a moving target moves in a step. What the session shows while the next answer is
+    // late (an app draws before the worker answers its frame), scaled to how late it is: the hand
+    // is not left the targets' motion since inside them.
+    double jobTime = 0.0;  // OuterJob::time
+    // predictedStep for kPredictedSteps[i] steps on (the same motion again that many times): a
+    // worker late by several frames leaves the session several steps of motion to cover.
+    static constexpr std::array<int, 4> kPredictedSteps{1, 2, 4, 8};
+    std::array<Pose, 4> predicted{};
+    // Where each target the job kept the hand out of was (world), and its farthest point from its
+    // origin (0: unbounded): how far the targets moved since this answer, for the session to tell.
+    struct Placed {
+      uint64_t id = 0;
+      Pose worldFromObject;
+      float reach = 0.0f;
+    };
+    std::vector<Placed> placed;
+    double stepInterval = 0.0;
+    Pose predictedStep;
     float sceneMotion = 0.0f;
   };
   // The newest finished outer-hand result of a slot, published by the worker and read from any
@@ -303,6 +318,7 @@ class GraspWorker {
       uint64_t version = 0;  // of the vertices
     };
     std::vector<Seen> lastScene;
+    double lastJobTime = 0.0;  // OuterJob::time of the last job run
   };
   struct Slot {
     std::optional<Job> queued;

@@ -153,16 +153,37 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
         break;
       }
     }
+    done->jobTime = job.time;
+    for (size_t k = 0; k < scene.size(); ++k)
+      done->placed.push_back({scene[k].id, scene[k].objectFromHand.inverse(), reaches[k]});
+    if (moving && job.time > o.lastJobTime) done->stepInterval = job.time - o.lastJobTime;
     o.lastScene = std::move(now);
+    o.lastJobTime = job.time;
     const SceneExactSource source(scene);
     auto r = o.hand->update(in, scene.empty() ? nullptr : &source);
     if (r) {
       done->result = *r;
-      done->predictedShownWrist = r->worldFromShownWrist;
-      if (moving) {
+      if (done->stepInterval > 0.0) {
         const SceneExactSource ahead(next);
-        if (auto c = o.hand->pushOutOf(ahead))
-          done->predictedShownWrist = *c * r->worldFromShownWrist;
+        if (auto c = o.hand->pushOutOf(ahead)) done->predictedStep = *c;
+        // Farther on: each moving member moved on by its step that many times.
+        for (size_t h = 0; h < OuterDone::kPredictedSteps.size(); ++h) {
+          const int steps = OuterDone::kPredictedSteps[h];
+          if (steps == 1) {
+            done->predicted[h] = done->predictedStep;
+            continue;
+          }
+          std::vector<SceneMember> far = scene;
+          for (size_t k = 0; k < scene.size(); ++k) {
+            const Pose worldNow = scene[k].objectFromHand.inverse();
+            const Pose step = next[k].objectFromHand.inverse() * scene[k].objectFromHand;
+            Pose w = worldNow;
+            for (int i = 0; i < steps; ++i) w = step * w;
+            far[k].objectFromHand = w.inverse();
+          }
+          const SceneExactSource farAhead(far);
+          if (auto c2 = o.hand->pushOutOf(farAhead)) done->predicted[h] = *c2;
+        }
       }
     } else {
       done->status = r.error().code;

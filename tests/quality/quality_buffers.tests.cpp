@@ -16,31 +16,21 @@
 #include "eval/scene_quality.h"
 #include "eval/scenes.h"
 #include "io/shapes.h"
+#include "quality_gates.h"
 #include "test_support.h"
 
 using namespace sdfg;
+using namespace sdfg::test;
 
 namespace {
 
-constexpr uint64_t kSeed = 1;
-constexpr unsigned kThreads = 2;  // grading; the figures do not depend on it
 // Fewer placements than the CPU meshes' 1000 (alone) and as many as their 100 (scenes): each
 // buffer grasp waits for the device's build on lavapipe.
 constexpr int kAlonePlacements = 200;
-constexpr int kScenePlacements = 100;
 
-// The single-object gates (quality.tests.cpp) and the scenes' (the same file, "Scenes").
-constexpr double kResidualMedianMm = 0.10;
-constexpr double kResidualP95Mm = 0.15;
-constexpr double kPenetrationMaxMm = 0.5;
-constexpr double kEarlyStopsPer1000 = 5.0;
-constexpr double kOtherPenetrationP99Mm = 1.0;
-constexpr double kOtherPenetrationMaxMm = 2.0;
-constexpr double kHeldPenetrationMaxMm = 1.0;
-constexpr double kV1ResidualMm = 0.2;
-// How far the buffer targets' contacts per grasp may fall below the CPU meshes' on the same
-// placements: the device's field differs from the CPU's in the last bits, which can move a
-// finger that grazes the surface by a step.
+// The gates are the CPU meshes' (quality_gates.h). How far the buffer targets' contacts per grasp
+// may fall below the CPU meshes' on the same placements: the device's field differs from the CPU's
+// in the last bits, which can move a finger that grazes the surface by a step.
 constexpr double kContactsSlack = 0.05;
 
 struct Measured {

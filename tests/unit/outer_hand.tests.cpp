@@ -88,6 +88,23 @@ struct Stepper {
   }
 };
 
+// One frame of a still hand at `wrist` with `shape` moved to `worldFromShape` (as the worker says
+// when a member's pose changed: sceneMoved).
+OuterHandResult stillHandStep(OuterHand& outer, const TestHand& h, const glm::vec3& wrist,
+                              int frame, const AnalyticShape& shape, const Pose& worldFromShape) {
+  const std::vector<SceneMember> members{{1, nullptr, &shape, worldFromShape.inverse()}};
+  const SceneExactSource scene(members);
+  OuterHandInput in;
+  in.worldFromWrist = at(wrist);
+  in.joints = &h.joints;
+  in.radii = &h.radii;
+  in.time = frame * kFrame;
+  in.sceneMoved = true;
+  const auto result = outer.update(in, &scene);
+  REQUIRE(result.ok());
+  return *result;
+}
+
 }  // namespace
 
 TEST_CASE("The outer hand is the tracked hand while nothing is near", "[core][outer_hand]") {
@@ -311,17 +328,7 @@ TEST_CASE("A target that moves into a still hand pushes the shown hand out of it
     const float travel = std::min(0.1f, perFrame * float(frame));
     const Pose worldFromShape = rising ? at(glm::vec3(0.0f, -0.02f + travel, 0.0f))
                                        : at(glm::vec3(0.12f - travel, touchHeight - 0.02f, 0.0f));
-    const std::vector<SceneMember> members{{1, nullptr, &shape, worldFromShape.inverse()}};
-    const SceneExactSource scene(members);
-    OuterHandInput in;
-    in.worldFromWrist = at(wrist);
-    in.joints = &h.joints;
-    in.radii = &h.radii;
-    in.time = frame * kFrame;
-    in.sceneMoved = true;  // as the worker says when a member's pose changed
-    const auto result = outer.update(in, &scene);
-    REQUIRE(result.ok());
-    r = *result;
+    r = stillHandStep(outer, h, wrist, frame, shape, worldFromShape);
     pushed = pushed || r.pushedOut;
     deepest = std::min(deepest, shownClearance(h, r, shape, worldFromShape));
   }
@@ -456,19 +463,10 @@ TEST_CASE("A thin plate moving through a still open hand at 2 m/s pushes it, nev
   for (int frame = 0; frame < 20; ++frame) {
     const float y = std::min(0.0015f + 0.0222f * float(frame), touchHeight + 0.06f);
     const Pose worldFromPlate = at(glm::vec3(0.0f, y, 0.0f));
-    const std::vector<SceneMember> members{{1, nullptr, &plate, worldFromPlate.inverse()}};
-    const SceneExactSource scene(members);
-    OuterHandInput in;
-    in.worldFromWrist = at(wrist);
-    in.joints = &h.joints;
-    in.radii = &h.radii;
-    in.time = frame * kFrame;
-    in.sceneMoved = true;
-    const auto result = outer.update(in, &scene);
-    REQUIRE(result.ok());
-    deepest = std::min(deepest, shownClearance(h, *result, plate, worldFromPlate));
+    const OuterHandResult result = stillHandStep(outer, h, wrist, frame, plate, worldFromPlate);
+    deepest = std::min(deepest, shownClearance(h, result, plate, worldFromPlate));
     // The shown wrist, relative to the plate: never on its far side.
-    lowestWrist = std::min(lowestWrist, result->worldFromShownWrist.position.y - y);
+    lowestWrist = std::min(lowestWrist, result.worldFromShownWrist.position.y - y);
   }
   CHECK(deepest >= -0.001f);
   CHECK(lowestWrist > 0.0f);

@@ -5,7 +5,12 @@
 
 namespace sdfg {
 
-void mergeShapeIntoField(const AnalyticShape& shape, const Pose& objectFromHand, SdfGrid& field) {
+namespace {
+
+// Merges `distance` (a signed distance of points in the member's frame) into `field` by the
+// minimum, the member placed by objectFromHand.
+template <class Distance>
+void mergeIntoField(const Pose& objectFromHand, SdfGrid& field, const Distance& distance) {
   const GridBox& box = field.box();
   const Pose objectFromBox = objectFromHand * box.handFromBox;
   std::span<float> values = field.values();
@@ -14,26 +19,23 @@ void mergeShapeIntoField(const AnalyticShape& shape, const Pose& objectFromHand,
       for (uint32_t i = 0; i < box.resolution.x; ++i) {
         const glm::vec3 p = objectFromBox.transformPoint(box.nodeLocal(i, j, k));
         float& v = values[field.index(i, j, k)];
-        v = std::min(v, shape.signedDistance(p));
+        v = std::min(v, distance(p));
       }
     }
   }
 }
 
+}  // namespace
+
+void mergeShapeIntoField(const AnalyticShape& shape, const Pose& objectFromHand, SdfGrid& field) {
+  mergeIntoField(objectFromHand, field,
+                 [&](const glm::vec3& p) { return shape.signedDistance(p); });
+}
+
 void mergeVolumeIntoField(const DistanceVolume& volume, const Pose& objectFromHand,
                           SdfGrid& field) {
-  const GridBox& box = field.box();
-  const Pose objectFromBox = objectFromHand * box.handFromBox;
-  std::span<float> values = field.values();
-  for (uint32_t k = 0; k < box.resolution.z; ++k) {
-    for (uint32_t j = 0; j < box.resolution.y; ++j) {
-      for (uint32_t i = 0; i < box.resolution.x; ++i) {
-        const glm::vec3 p = objectFromBox.transformPoint(box.nodeLocal(i, j, k));
-        float& v = values[field.index(i, j, k)];
-        v = std::min(v, volume.signedDistance(p));
-      }
-    }
-  }
+  mergeIntoField(objectFromHand, field,
+                 [&](const glm::vec3& p) { return volume.signedDistance(p); });
 }
 
 Status buildSceneField(std::span<const SceneMember> members, const GridBox& box,

@@ -42,16 +42,12 @@ SceneObject mugAt(const std::string& name, const glm::vec3& floorCentre, float t
   return o;
 }
 
-}  // namespace
-
-SceneObject makeTable() {
-  return boxObject("table", kTableHalf, glm::vec3(0.0f, -kTableHalf.y, 0.0f));
-}
-
-BenchScene aloneScene(const std::string& name, const TriangleMesh& mesh) {
+// A scene of `mesh` scaled to the benchmark's size, named "<name>/<suffix>".
+BenchScene scaledScene(const std::string& name, const TriangleMesh& mesh, const char* suffix,
+                       const char* where) {
   BenchScene scene;
-  scene.name = name + "/alone";
-  scene.description = name + " (scaled to the benchmark's size) alone";
+  scene.name = name + "/" + suffix;
+  scene.description = name + " (scaled to the benchmark's size) " + where;
   SceneObject object;
   object.name = name;
   object.mesh = normalizedToDiagonal(mesh, kBenchObjectDiagonal);
@@ -59,16 +55,21 @@ BenchScene aloneScene(const std::string& name, const TriangleMesh& mesh) {
   return scene;
 }
 
+}  // namespace
+
+SceneObject makeTable() {
+  return boxObject("table", kTableHalf, glm::vec3(0.0f, -kTableHalf.y, 0.0f));
+}
+
+BenchScene aloneScene(const std::string& name, const TriangleMesh& mesh) {
+  return scaledScene(name, mesh, "alone", "alone");
+}
+
 BenchScene tableScene(const std::string& name, const TriangleMesh& mesh) {
-  BenchScene scene;
-  scene.name = name + "/table";
-  scene.description = name + " (scaled to the benchmark's size) resting on a table top";
-  SceneObject object;
-  object.name = name;
-  object.mesh = normalizedToDiagonal(mesh, kBenchObjectDiagonal);
+  BenchScene scene = scaledScene(name, mesh, "table", "resting on a table top");
+  SceneObject& object = scene.objects[0];
   const Aabb bounds = computeBounds(object.mesh.positions);
   object.worldFromObject.position = glm::vec3(0.0f, -bounds.min.y, 0.0f);
-  scene.objects.push_back(std::move(object));
   scene.objects.push_back(makeTable());
   scene.reachedFor = 0;
   return scene;

@@ -5,6 +5,9 @@
 // `objectFromHand * handFromBox == objectFromBox`.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
 
@@ -27,5 +30,10 @@ struct Pose {
     return Pose{glm::normalize(a.orientation * b.orientation), a.transformPoint(b.position)};
   }
 };
+
+// The angle of the rotation `q` (radians, in [0, pi]).
+inline float rotationAngle(const glm::quat& q) {
+  return 2.0f * std::acos(std::min(1.0f, std::abs(q.w)));
+}
 
 }  // namespace sdfg

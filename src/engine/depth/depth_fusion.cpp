@@ -76,11 +76,8 @@ void DepthFusion::recentre(const glm::vec3& centre) {
   value_ = std::move(value);
   weight_ = std::move(weight);
   seen_ = std::move(seen);
+  // volume() stays what it was (true where it was) until the next finishFrame() rebuilds it here.
   corner_ = corner;
-  volume_ = DistanceVolume(glm::vec3(corner_) * options_.voxel, options_.voxel, glm::uvec3(n_),
-                           options_.truncation);
-  for (size_t v = 0; v < value_.size(); ++v)
-    volume_.values()[v] = weight_[v] > 0.0f ? value_[v] : options_.truncation;
 }
 
 Status DepthFusion::integrate(const DepthView& view, std::span<const float> depth,
@@ -143,7 +140,8 @@ Status DepthFusion::integrate(const DepthView& view, std::span<const float> dept
   for (uint32_t k = 0; k < n_; ++k) {
     for (uint32_t j = 0; j < n_; ++j) {
       for (uint32_t i = 0; i < n_; ++i) {
-        const glm::vec3 v = viewFromWorld.transformPoint(volume_.node(i, j, k));
+        const glm::vec3 v = viewFromWorld.transformPoint(
+            origin + options_.voxel * glm::vec3(float(i), float(j), float(k)));
         const float zx = -v.z;
         if (!(zx > 0.0f)) continue;
         const float fx = (v.x / zx - tl) * sx, fy = (tu - v.y / zx) * sy;
@@ -168,13 +166,17 @@ Status DepthFusion::integrate(const DepthView& view, std::span<const float> dept
 }
 
 void DepthFusion::finishFrame(double time) {
-  const float tau = options_.truncation;
   for (size_t n = 0; n < value_.size(); ++n) {
     if (weight_[n] > 0.0f && time - seen_[n] > options_.forgetAfter) {
       weight_[n] = 0.0f;
-      value_[n] = tau;
+      value_[n] = options_.truncation;
     }
   }
+  refreshVolume();
+}
+
+void DepthFusion::refreshVolume() {
+  const float tau = options_.truncation;
   // The fused values are distances along the view rays, which overstate the distance to a
   // surface seen at a grazing angle (beside a silhouette, the ray passes the object and meets the
   // table far behind). They keep the sign; the magnitude is the Euclidean distance to the fused
@@ -245,6 +247,9 @@ void DepthFusion::finishFrame(double time) {
         for (int i = n - 1; i >= 0; --i)
           for (const auto& o : kBefore) relax(i, j, k, -o[0], -o[1], -o[2]);
   }
+  if (volume_.origin() != glm::vec3(corner_) * options_.voxel)
+    volume_ =
+        DistanceVolume(glm::vec3(corner_) * options_.voxel, options_.voxel, glm::uvec3(n_), tau);
   std::span<float> out = volume_.values();
   for (size_t v = 0; v < count; ++v) {
     const float d = std::min(tau, options_.voxel * distance_[v]);

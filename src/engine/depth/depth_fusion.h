@@ -62,7 +62,7 @@ class DepthFusion {
   static Result<DepthFusion> create(const DepthFusionOptions& options);
 
   // Centres the cube on `centre` (world), rounded to whole voxels; what the old cube and the new
-  // one share is kept, the rest starts unobserved.
+  // one share is kept, the rest starts unobserved. volume() moves with the next finishFrame().
   void recentre(const glm::vec3& centre);
   // Fuses one view at time `time` (seconds, not decreasing): `depth` holds the view's stored
   // values, width x height, row-major from the top row. Errors: invalid_argument (the view's
@@ -81,6 +81,8 @@ class DepthFusion {
  private:
   explicit DepthFusion(const DepthFusionOptions& options);
   size_t index(uint32_t i, uint32_t j, uint32_t k) const { return volume_.index(i, j, k); }
+  // volume() from the fused values: their signs, and the Euclidean distance to their surface.
+  void refreshVolume();
 
   DepthFusionOptions options_;
   uint32_t n_ = 0;            // nodes per axis
@@ -90,7 +92,7 @@ class DepthFusion {
   std::vector<double> seen_;  // time of the last observation
   DistanceVolume volume_;
   std::vector<uint8_t> handMask_;  // scratch: per pixel of the view being fused
-  // Scratch of finishFrame(): the fused surface's points (node units), and per node the nearest
+  // Scratch of refreshVolume(): the fused surface's points (node units), and per node the nearest
   // of them and its distance (node units).
   std::vector<glm::vec3> surface_;
   std::vector<int32_t> nearest_;

@@ -21,25 +21,6 @@ constexpr float kCurlSlack = 0.01f;
 // was then: no more closed.
 constexpr float kFingerStill = 0.0005f;
 
-// A late answer's prediction goes at most this many steps of the targets' motion ahead.
-constexpr double kMaxPredictedSteps = 8.0;
-
-// `step` (a rigid motion) taken `times` times (a fraction: the last time in part).
-Pose repeatedMotion(const Pose& step, double times) {
-  Pose out;
-  const int whole = int(times);
-  for (int i = 0; i < whole; ++i) out = step * out;
-  const float part = float(times - double(whole));
-  if (part > 0.0f)
-    out =
-        Pose{glm::slerp(glm::quat(1, 0, 0, 0), step.orientation, part), step.position * part} * out;
-  return out;
-}
-
-float angleOf(const glm::quat& q) {
-  return 2.0f * std::acos(std::min(1.0f, std::abs(q.w)));
-}
-
 }  // namespace
 
 void GraspSession::outerMembers(const glm::vec3& centre, float half, uint64_t held,
@@ -148,7 +129,7 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
     double steps = 1.0;
     if (latest->stepInterval > 0.0)
       steps = std::clamp((double(frame.time) * 1e-9 - latest->jobTime) / latest->stepInterval, 0.0,
-                         kMaxPredictedSteps);
+                         double(GraspWorker::OuterDone::kPredictedSteps.back()));
     bool clear = !r.constrained;
     if (clear) {
       float motion = sinceResult;
@@ -156,7 +137,7 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
         const Pose turn = latest->trackedWrist.inverse() * frame.worldFromWrist;
         motion = std::max(
             motion, glm::length(frame.worldFromWrist.position - latest->trackedWrist.position) +
-                        angleOf(turn.orientation) * latest->attachedReach);
+                        rotationAngle(turn.orientation) * latest->attachedReach);
       }
       // The targets move too: as far as any moved since that answer (where they are now, against
       // where the job saw them), or as the worker's estimate of their motion says, the larger.
@@ -165,20 +146,18 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
         const std::optional<Pose> now = index_.worldFromObject(p.id);
         if (!now) continue;
         const Pose delta = *now * p.worldFromObject.inverse();
-        targetMotion = std::max(targetMotion,
-                                glm::length(now->position - p.worldFromObject.position) +
-                                    angleOf(delta.orientation) * (p.reach > 0.0f ? p.reach : 1.0f));
+        targetMotion = std::max(
+            targetMotion, glm::length(now->position - p.worldFromObject.position) +
+                              rotationAngle(delta.orientation) * (p.reach > 0.0f ? p.reach : 1.0f));
       }
       clear = motion + targetMotion + settings_.outerOptions.margin < r.clearance;
     }
     if (!clear) {
       // Where that result's hand must be to be out of the scene as it is now, with its moving
       // targets moved on as they moved (the same motion again, once per step since the answer):
-      // not their motion since inside them.
-      // The shortest prediction that reaches this frame (a hand pushed a little ahead of a
-      // target is clear; one behind it is inside); past the longest, that one repeated.
-      Pose push = repeatedMotion(latest->predicted.back(),
-                                 steps / double(GraspWorker::OuterDone::kPredictedSteps.back()));
+      // the shortest prediction that reaches this frame (a hand pushed a little ahead of a
+      // target is clear; one behind it is inside), or the longest.
+      Pose push = latest->predicted.back();
       for (size_t h = 0; h < latest->predicted.size(); ++h) {
         if (double(GraspWorker::OuterDone::kPredictedSteps[h]) + 1e-6 >= steps) {
           push = latest->predicted[h];

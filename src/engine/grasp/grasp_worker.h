@@ -192,15 +192,14 @@ class GraspWorker {
     // Set-ups the worker had finished when it started the job (cumulative, as setupsDone()):
     // shows that a queued set-up did not delay it.
     uint64_t setupsBefore = 0;
-    // One step on (as long as from the job before to this one, `stepInterval` seconds; 0: nothing
-    // moved): the correction (world, applied after the shown wrist) that keeps the shown hand out
-    // of the scene with its moving targets moved on as they moved in the step before, and how far
-    // a part of a moving target moves in a step. What the session shows while the next answer is
-    // late (an app draws before the worker answers its frame), scaled to how late it is: the hand
-    // is not left the targets' motion since inside them.
+    // What the session shows while the next answer is late (an app draws before the worker
+    // answers its frame), so that the hand is not left the targets' motion since inside them. A
+    // step is as long as from the job before to this one (`stepInterval` seconds; 0: nothing
+    // moved); predicted[h] is the correction (world, applied after the shown wrist) that keeps
+    // the shown hand out of the scene with its moving targets moved on kPredictedSteps[h] steps
+    // as they moved in the step before (a worker late by several frames leaves several steps of
+    // motion to cover); sceneMotion how far a part of a moving target moves in a step.
     double jobTime = 0.0;  // OuterJob::time
-    // predictedStep for kPredictedSteps[i] steps on (the same motion again that many times): a
-    // worker late by several frames leaves the session several steps of motion to cover.
     static constexpr std::array<int, 4> kPredictedSteps{1, 2, 4, 8};
     std::array<Pose, 4> predicted{};
     // Where each target the job kept the hand out of was (world), and its farthest point from its
@@ -212,7 +211,6 @@ class GraspWorker {
     };
     std::vector<Placed> placed;
     double stepInterval = 0.0;
-    Pose predictedStep;
     float sceneMotion = 0.0f;
   };
   // The newest finished outer-hand result of a slot, published by the worker and read from any

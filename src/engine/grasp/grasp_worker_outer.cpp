@@ -123,33 +123,28 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
     in.drawnOffset = job.drawnOffset;
     // A target that moved, or that the app deformed, since the last job may now be in the hand
     // shown then. (One that only came within reach did not: the hand's own motion brought it.)
+    // Each one that moved makes a step (W_now W_prev^-1; objectFromHand maps world points, so
+    // a = W^-1) that the predictions repeat.
     std::vector<OuterSlot::Seen> now;
-    for (size_t k = 0; k < scene.size(); ++k)
-      now.push_back({scene[k].id, scene[k].objectFromHand, versions[k]});
-    in.sceneMoved = std::any_of(now.begin(), now.end(), [&](const OuterSlot::Seen& m) {
-      return std::any_of(o.lastScene.begin(), o.lastScene.end(), [&](const OuterSlot::Seen& was) {
-        return was.id == m.id && (was.objectFromHand.position != m.objectFromHand.position ||
-                                  was.objectFromHand.orientation != m.objectFromHand.orientation ||
-                                  was.version != m.version);
-      });
-    });
-    // The scene a frame on: each member that moved since the last job moved on by the same
-    // rigid motion (objectFromHand maps world points: a = W^-1, so W_next = W W_prev^-1 W).
-    std::vector<SceneMember> next = scene;
+    std::vector<Pose> steps(scene.size());  // identity: still
     bool moving = false;
+    in.sceneMoved = false;
     for (size_t k = 0; k < scene.size(); ++k) {
+      now.push_back({scene[k].id, scene[k].objectFromHand, versions[k]});
       for (const OuterSlot::Seen& was : o.lastScene) {
         if (was.id != scene[k].id) continue;
         const Pose worldNow = scene[k].objectFromHand.inverse();
-        const Pose step = worldNow * was.objectFromHand;  // W_now W_prev^-1
-        const float turn = 2.0f * std::acos(std::min(1.0f, std::abs(step.orientation.w)));
+        steps[k] = worldNow * was.objectFromHand;
+        const float turn = rotationAngle(steps[k].orientation);
         const float travel =
-            glm::length(step.transformPoint(worldNow.position) - worldNow.position);
-        if (travel == 0.0f && turn == 0.0f) break;
-        moving = true;
-        next[k].objectFromHand = (step * worldNow).inverse();
+            glm::length(steps[k].transformPoint(worldNow.position) - worldNow.position);
+        const bool moved = travel != 0.0f || turn != 0.0f;
+        in.sceneMoved = in.sceneMoved || was.version != versions[k] ||
+                        was.objectFromHand.position != scene[k].objectFromHand.position ||
+                        was.objectFromHand.orientation != scene[k].objectFromHand.orientation;
+        moving = moving || moved;
         // An unbounded shape (a plane) turning sweeps without bound: counted by its travel.
-        done->sceneMotion = std::max(done->sceneMotion, travel + turn * reaches[k]);
+        if (moved) done->sceneMotion = std::max(done->sceneMotion, travel + turn * reaches[k]);
         break;
       }
     }
@@ -163,27 +158,16 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
     auto r = o.hand->update(in, scene.empty() ? nullptr : &source);
     if (r) {
       done->result = *r;
-      if (done->stepInterval > 0.0) {
-        const SceneExactSource ahead(next);
-        if (auto c = o.hand->pushOutOf(ahead)) done->predictedStep = *c;
-        // Farther on: each moving member moved on by its step that many times.
-        for (size_t h = 0; h < OuterDone::kPredictedSteps.size(); ++h) {
-          const int steps = OuterDone::kPredictedSteps[h];
-          if (steps == 1) {
-            done->predicted[h] = done->predictedStep;
-            continue;
-          }
-          std::vector<SceneMember> far = scene;
-          for (size_t k = 0; k < scene.size(); ++k) {
-            const Pose worldNow = scene[k].objectFromHand.inverse();
-            const Pose step = next[k].objectFromHand.inverse() * scene[k].objectFromHand;
-            Pose w = worldNow;
-            for (int i = 0; i < steps; ++i) w = step * w;
-            far[k].objectFromHand = w.inverse();
-          }
-          const SceneExactSource farAhead(far);
-          if (auto c2 = o.hand->pushOutOf(farAhead)) done->predicted[h] = *c2;
+      // The scene kPredictedSteps[h] steps on, each member moved by its step that many times, and
+      // the shown hand pushed out of it.
+      for (size_t h = 0; h < OuterDone::kPredictedSteps.size() && done->stepInterval > 0.0; ++h) {
+        std::vector<SceneMember> ahead = scene;
+        for (size_t k = 0; k < scene.size(); ++k) {
+          Pose w = scene[k].objectFromHand.inverse();
+          for (int i = 0; i < OuterDone::kPredictedSteps[h]; ++i) w = steps[k] * w;
+          ahead[k].objectFromHand = w.inverse();
         }
+        if (auto c = o.hand->pushOutOf(SceneExactSource(ahead))) done->predicted[h] = *c;
       }
     } else {
       done->status = r.error().code;

@@ -298,17 +298,27 @@ std::optional<Pose> pushOut(std::span<const glm::vec3> world, std::span<const fl
 
 }  // namespace
 
+void OuterHand::shownSpheres(std::span<const glm::vec3> rigid, std::span<const float> rigidRadius,
+                             bool fingers, std::vector<glm::vec3>& world,
+                             std::vector<float>& radii) const {
+  world.clear();
+  radii.assign(rigidRadius.begin(), rigidRadius.end());
+  for (const glm::vec3& p : rigid) world.push_back(shown_.transformPoint(p));
+  std::vector<glm::vec3> spheres;
+  for (int f = 0; f < kFingerCount && fingers; ++f) {
+    fingerSpheres(f, curl_[size_t(f)], spheres);
+    for (const glm::vec3& p : spheres) world.push_back(shown_.transformPoint(p));
+    radii.insert(radii.end(), rigs_[size_t(f)].radius.begin(), rigs_[size_t(f)].radius.end());
+  }
+}
+
 std::optional<Pose> OuterHand::pushOutOf(const ExactDistanceSource& scene) const {
   if (!engaged_ || shownRigid_.empty()) return std::nullopt;
   std::vector<glm::vec3> world;
-  glm::vec3 centre(0.0f);
-  for (const glm::vec3& p : shownRigid_) {
-    world.push_back(shown_.transformPoint(p));
-    centre += world.back();
-  }
-  centre /= float(world.size());
+  std::vector<float> radii;
+  shownSpheres(shownRigid_, shownRigidRadius_, !shownRigidFingers_, world, radii);
   int samples = 0;
-  return pushOut(world, shownRigidRadius_, centre, scene, options_, samples);
+  return pushOut(world, radii, shown_.transformPoint(shownPivot_), scene, options_, samples);
 }
 
 std::vector<HandPart> surfaceParts(const TriangleMesh& mesh) {
@@ -514,6 +524,8 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
   std::vector<float> lastRigidRadius(rigid.radius.begin(), rigid.radius.begin() + handRigid);
   std::swap(lastRigid, shownRigid_);
   std::swap(lastRigidRadius, shownRigidRadius_);
+  shownPivot_ = pivot;
+  shownRigidFingers_ = in.rigidFingers;
 
   // The largest motion of any part between two wrist poses.
   auto motion = [&](const Pose& a, const Pose& b) {
@@ -702,15 +714,8 @@ Result<OuterHandResult> OuterHand::update(const OuterHandInput& in,
   // leave them in it.
   if (in.sceneMoved && !lastRigid.empty()) {
     std::vector<glm::vec3> handWorld;
-    std::vector<float> handRadii = lastRigidRadius;
-    for (const glm::vec3& p : lastRigid) handWorld.push_back(shown_.transformPoint(p));
-    std::vector<glm::vec3> spheres;
-    for (int f = 0; f < kFingerCount && !in.rigidFingers; ++f) {
-      fingerSpheres(f, curl_[size_t(f)], spheres);
-      for (const glm::vec3& p : spheres) handWorld.push_back(shown_.transformPoint(p));
-      handRadii.insert(handRadii.end(), rigs_[size_t(f)].radius.begin(),
-                       rigs_[size_t(f)].radius.end());
-    }
+    std::vector<float> handRadii;
+    shownSpheres(lastRigid, lastRigidRadius, !in.rigidFingers, handWorld, handRadii);
     if (auto c = pushOut(handWorld, handRadii, shown_.transformPoint(pivot), *scene, options_,
                          slideSamples)) {
       shown_ = *c * shown_;

@@ -122,9 +122,10 @@ class OuterHand {
   void setOptions(const OuterHandOptions& options) { options_ = options; }
   const HandModel& model() const { return model_; }
   // The smallest rigid motion (world, applied after the shown pose) that takes the hand shown last
-  // (its rigid parts) out of `scene`, e.g. the scene a frame on with its moving targets where
-  // their motion takes them; nothing when it is out already, nothing was shown, or no clear pose
-  // is within the release distance.
+  // (its rigid parts and, unless they were a grasp's, its fingers at their shown curls: what
+  // update() pushes out of a target that moved in) out of `scene`, e.g. the scene a frame on with
+  // its moving targets where their motion takes them; nothing when it is out already, nothing was
+  // shown, or no clear pose is within the release distance.
   std::optional<Pose> pushOutOf(const ExactDistanceSource& scene) const;
 
  private:
@@ -136,6 +137,10 @@ class OuterHand {
   void prepareFingers();
   // The sphere centres of finger f at curl a (wrist frame).
   void fingerSpheres(int f, float a, std::vector<glm::vec3>& out) const;
+  // The hand as shown at shown_ (world spheres and radii): `rigid` parts (wrist frame) and, with
+  // `fingers`, every finger at its shown curl (curl_).
+  void shownSpheres(std::span<const glm::vec3> rigid, std::span<const float> rigidRadius,
+                    bool fingers, std::vector<glm::vec3>& world, std::vector<float>& radii) const;
 
   HandModel model_;
   OuterHandOptions options_;
@@ -151,6 +156,8 @@ class OuterHand {
   // the hand is tested against, at shown_ (empty: no update since the last reset).
   std::vector<glm::vec3> shownRigid_;
   std::vector<float> shownRigidRadius_;
+  glm::vec3 shownPivot_{0.0f};      // the palm then (wrist frame): where a push turns about
+  bool shownRigidFingers_ = false;  // the fingers were a grasp's (OuterHandInput::rigidFingers)
   bool released_ = false;
   bool blending_ = false;
   double blendStart_ = 0.0;

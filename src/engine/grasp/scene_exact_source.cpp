@@ -31,8 +31,7 @@ void SceneExactSource::sample(std::span<const glm::vec3> handPoints,
         d = member.mesh->localSignedDistanceNear(
             p, maxDistances[i], hintMember == m ? hintTriangle : kNoFeature, &closest, &triangle);
       } else {
-        d = member.shape != nullptr ? member.shape->closest(p, closest)
-                                    : member.volume->closest(p, closest);
+        d = closestOfSolid(member, p, closest);
         // A volume knows of no surface farther than its band (it reads the band's edge there).
         const bool beyondBand = member.volume != nullptr && d >= member.volume->truncation();
         if (std::abs(d) > maxDistances[i] || beyondBand) d = std::numeric_limits<float>::infinity();

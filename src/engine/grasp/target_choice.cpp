@@ -12,7 +12,7 @@ float distanceTo(const SceneMember& m, const glm::vec3& hand) {
   const glm::vec3 p = m.objectFromHand.transformPoint(hand);
   if (m.mesh != nullptr) return m.mesh->closest(p).distance;
   glm::vec3 unused;
-  return std::abs(m.shape != nullptr ? m.shape->closest(p, unused) : m.volume->closest(p, unused));
+  return std::abs(closestOfSolid(m, p, unused));
 }
 
 // The member whose surface the ray from `origin` along `direction` meets first within

@@ -32,6 +32,12 @@ struct SceneMember {
   const DistanceVolume* volume = nullptr;  // a sampled solid (the depth scene's)
 };
 
+// The signed distance at `p` (the member's own frame) of a member without triangles (a shape or a
+// volume), and its closest surface point.
+inline float closestOfSolid(const SceneMember& m, const glm::vec3& p, glm::vec3& closest) {
+  return m.shape != nullptr ? m.shape->closest(p, closest) : m.volume->closest(p, closest);
+}
+
 // At most this many members take part in one grasp: more targets than this in one grab box are
 // cut to the nearest (the exact source's feature ids carry the member index in 8 bits).
 inline constexpr size_t kMaxSceneMembers = 255;

@@ -89,6 +89,25 @@ TEST_CASE("A squeezed hand closes onto a mug handle (torus bar) within 2 mm", "[
   checkContacts(out, [&](const XrVector3f& p) { return torusDistance(pose, major, minor, p); });
 }
 
+// The same bar 2.2 cm to the side of the hand (where the outer hand once showed a hand the bar was
+// set up in): the ring finger passes beside the bar, where the field's far nodes are low bounds.
+// It stopped there at curl 0.85 and was reported in contact 42 mm from the bar; now the exact
+// check's finding of nothing near closes it on (fully), and only fingers on the bar say contact.
+TEST_CASE("A finger the field stops beside a mug handle is closed on, not reported in contact",
+          "[layer][grasp]") {
+  const XrPosef centred{{0, 0, 0, 1}, {-0.2f, -0.3f, -0.4f}};
+  const XrVector3f centre = boxCentreInLocal(centred, /*right=*/false);
+  const XrPosef grip{{0, 0, 0, 1}, {-0.2f + 0.0222f, -0.3f - 0.0029f, -0.4f}};
+  const float major = 0.04f, minor = 0.009f;
+  const XrPosef pose{{0, 0.70710678f, 0, 0.70710678f}, {centre.x, centre.y - 0.005f, centre.z}};
+  GraspOutcome out = graspScene(makeTorus(major, minor, 64, 24), pose, grip, "left", 32);
+  checkContacts(
+      out, [&](const XrVector3f& p) { return torusDistance(pose, major, minor, p); },
+      /*minContacts=*/1);
+  CHECK(out.state.fingers[3].inContact == XR_FALSE);
+  CHECK(out.state.fingers[3].curl == Approx(1.0f));
+}
+
 // Where the open right hand driven by `grip` is, in LOCAL space: its palm joint, the palm's
 // normal (out of the palm) and the axis across its fingers (index knuckle to little knuckle).
 struct OpenHand {

@@ -292,6 +292,7 @@ Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {
     JointCurls curls{0.0f, 0.0f, 0.0f, 0.0f};
     int firstFree = 0;
     float a = 0.0f;
+    int restarts = 0;  // field stops the exact check found false, closed on from
     while (firstFree < n) {
       int touching = -1;
       glm::vec3 point(0.0f);
@@ -306,8 +307,12 @@ Status OursSolver::solve(const GraspScene& scene, GraspResult& out) const {
       a = stage(st, curls, a, touching, point, value);
       if (scene.exact != nullptr) {
         const Clock::time_point t0 = Clock::now();
+        const bool fieldStopped = touching >= 0;
         a = exactStop(cx, f, firstFree, a, curls, touching, point, value, out.exactSamples);
         checkTime += Clock::now() - t0;
+        // The field stopped the group where the exact surface is not near: closed on from the
+        // pose the check reached, on the field again (its bounds far from the surface are low).
+        if (fieldStopped && touching < 0 && a < 1.0f && ++restarts <= kMaxFalseStops) continue;
       }
       if (touching < 0) break;
       // The most distal contact is the one reported: it is where the finger ends up resting.

@@ -43,6 +43,9 @@ constexpr int kMaxRefineIterations = 40;
 // the dragon).
 constexpr int kMaxExactIterations = 32;
 constexpr int kMaxExactBackoff = 6;
+// Field stops per finger group that the exact check may find false (nothing near) and close on
+// from before the finger is left where the last check ended.
+constexpr int kMaxFalseStops = 4;
 // A candidate not sampled yet is taken to be no nearer than its field clearance minus this (the
 // 16^3 field's error is within it on all but the sharpest parts), so when the closest one's
 // exact clearance is below that bound the others are not sampled: most stops then take one

@@ -33,7 +33,8 @@ struct ExactEval {
 // most closed pose with no checked sphere inside is kept; if none was found, the group opens in
 // doubling steps while that helps and the least inside pose is kept. Reports the closest sphere
 // as the touching one when it is within the tolerance (or when the field said it touched, unless
-// the group closed fully and is clear of the exact surface: then nothing touches).
+// the pose kept is clear of the exact surface and either fully closed or with no surface within
+// the band of any sphere checked: then nothing touches, and the caller closes the group on).
 float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, float a,
                             JointCurls& curls, int& touching, glm::vec3& touchPoint,
                             float& touchValue, int& samples) const {
@@ -352,9 +353,12 @@ float OursSolver::exactStop(const ExactContext& cx, int f, int firstFree, float 
     safe = least;
   }
   setCurl(aSafe);
-  // Fully closed and clear of the exact surface: the field's contact was its own error, and the
-  // finger touches nothing (it would otherwise report a contact millimetres off the surface).
-  if (aSafe >= 1.0f && safe.g > tol) {
+  // Clear of the exact surface by more than the tolerance at the pose kept, fully closed or with
+  // no surface within the search band of any sphere checked: the field's contact was its own error
+  // (a far node's bound reads millimetres where the surface is centimetres off), and the finger
+  // touches nothing here (it would otherwise report the field's point, of another pose). The
+  // caller closes it on from here.
+  if ((aSafe >= 1.0f || safe.arg < 0) && safe.g > tol) {
     touching = -1;
     return aSafe;
   }

@@ -185,6 +185,7 @@ Status GraspSession::update(Hand side, const HandFrame& frame,
 Status GraspSession::update(Hand side, const HandFrame& tracked,
                             std::span<const SpaceFrame> spaces) {
   index_.setSpaces(spaces);
+  if (depthOn_) index_.locate(kDepthWorldSpace, Pose{});
   const size_t slot = size_t(side);
   HandState& hand = hands_[slot];
   hand.squeeze = std::isfinite(tracked.squeeze) ? tracked.squeeze : 0.0f;
@@ -192,6 +193,7 @@ Status GraspSession::update(Hand side, const HandFrame& tracked,
   if (tracked.valid) hand.lastWrist = tracked.worldFromWrist;
   refreshSetups();
   collectReadbacks();
+  collectDepth();
   const Status jobStatus = collectJob(hand, slot);
   Status collected = jobStatus == Status::ok ? collect(hand, slot) : jobStatus;
   // A grasp that ends this frame ends before the outer hand looks: the object let go is scene
@@ -235,6 +237,9 @@ Status GraspSession::update(Hand side, const HandFrame& tracked,
     }
     // The build in flight first, then re-check.
     if (members.empty() || hand.pending || hand.jobPending) return collected;
+    // The depth scene changes with every frame fused and stays where it was seen when the app
+    // carries what the hand took: the first solve is kept (enableDepthScene).
+    if (isDepthTarget(held) && hand.grasp.solves > 0) return collected;
     if (hand.grasp.solves > 0 && !sceneChanged(hand, members)) return collected;
     noteTrackedParts(hand, frame);
     const Status s = solve(hand, slot, std::move(members));

@@ -268,6 +268,35 @@ class GraspSession {
   bool removeTarget(uint64_t id);
   bool hasTarget(uint64_t id) const { return targets_.count(id) != 0; }
 
+  // The depth scene (depth/depth_fusion.h, docs/depth.md): what the app draws, known only through
+  // the depth it submits, fused on the worker into a volume around each hand. Each volume is a
+  // target (depthTarget(hand)), graspable by both hands and kept out by the outer hand like any
+  // other; setTargetRole() makes it scene geometry or ignores it. It is empty, and takes part in
+  // nothing, until the first frame fused near that hand. A hand that takes it keeps its first
+  // solve until the release (the volume changes every frame; the hand does not follow it).
+  // Errors: invalid_argument (options validate() refuses, or on already).
+  Status enableDepthScene(const DepthFusionOptions& options = {});
+  bool depthSceneEnabled() const { return depthOn_; }
+  // One frame of the app's depth: its views and their stored values (DepthFusion::integrate), at
+  // `time` (seconds, not decreasing). Fused around where each hand was at its last update, with
+  // the hands the app draws left out (their model at the wrist the update had, as shown); a frame
+  // the worker has not started is replaced. Errors: unsupported (the depth scene is off),
+  // invalid_argument (a view validate() refuses, or stored values of the wrong count: nothing is
+  // queued).
+  Status submitDepth(std::vector<DepthView> views, std::vector<std::vector<float>> depth,
+                     double time);
+  // The depth scene's target near `hand`: ids the caller's own never take (bit 62 set; the layer's
+  // keys are handles and pointers).
+  static constexpr uint64_t kDepthTargetBase = uint64_t(1) << 62;
+  // The space the depth targets are placed in: the world itself (update()'s frames).
+  static constexpr uint64_t kDepthWorldSpace = (uint64_t(3) << 62) | 0xffffu;
+  static uint64_t depthTarget(Hand hand) { return kDepthTargetBase | uint64_t(hand); }
+  static bool isDepthTarget(uint64_t id) {
+    return id == depthTarget(Hand::left) || id == depthTarget(Hand::right);
+  }
+  // What the worker last fused near `hand` (valid: a frame was fused).
+  const GraspWorker::DepthDone& depthState(Hand hand) const { return depthDone_[size_t(hand)]; }
+
   // Advances one hand, with the spaces where they are this frame (targets in spaces not listed,
   // or not valid, take part in nothing this frame). Returns the first error met while solving (the
   // hand then stays open).
@@ -320,6 +349,7 @@ class GraspSession {
     bool meshTarget = false;    // CPU arrays (addTarget), not device buffers
     bool shapeTarget = false;   // an analytic shape (addShapeTarget)
     bool deviceTarget = false;  // the deferred backend's mesh (addDeviceTarget)
+    bool volumeTarget = false;  // a depth scene's volume (enableDepthScene)
     Mirror mirror = Mirror::none;
     uint64_t readbackApplied = 0;  // generation of the newest one handed to the worker
     bool readbackStale = false;    // changed since, while far from every hand
@@ -391,7 +421,7 @@ class GraspSession {
   // Whether the worker has the target's distance on the CPU (a mesh, a shape, or a device
   // target's readback): the exact check, the choice and the outer hand see only these.
   static bool onCpu(const Target& t) {
-    return t.meshTarget || t.shapeTarget || t.mirror == Mirror::ready;
+    return t.meshTarget || t.shapeTarget || t.volumeTarget || t.mirror == Mirror::ready;
   }
   // Readbacks (grasp_session_readback.cpp): asks for one of the target's mesh; takes those that
   // arrived and the worker's set-ups of them; asks for the stale ones now near a hand.
@@ -426,6 +456,8 @@ class GraspSession {
             std::optional<SdfGrid> field, bool gpu, int64_t time);
   Status prepareSolver(HandState& hand);
   void refreshSetups();
+  // Takes what the worker fused since the last update: the depth targets' versions and bounds.
+  void collectDepth();
   void cancelPending(HandState& hand, size_t slot);
   // The scene in the grab box of a hand at worldFromWrist: every placed, set-up target that is not
   // ignored whose bounds overlap the box, relative to the hand, graspable when `side` may take it
@@ -444,6 +476,8 @@ class GraspSession {
   GraspSettings settings_;
   std::map<uint64_t, Target> targets_;
   SceneIndex index_;
+  bool depthOn_ = false;
+  std::array<GraspWorker::DepthDone, 2> depthDone_{};
   std::vector<std::pair<uint64_t, MeshSetupReport>> setupReports_;
   std::vector<uint64_t> pendingSetups_;  // ids whose set-up may still be running (refreshSetups)
   size_t failedSetups_ = 0;

@@ -98,7 +98,8 @@ GraspSession::SetupCounts GraspSession::setupCounts() {
   collectReadbacks();
   c.pending = pendingSetups_.size() + mirrorsPending_;
   c.failed = failedSetups_;
-  c.ready = targets_.size() - c.pending - c.failed;
+  // The depth scene's targets are the session's own, not the caller's to count.
+  c.ready = targets_.size() - c.pending - c.failed - (depthOn_ ? 2 : 0);
   return c;
 }
 
@@ -144,6 +145,7 @@ TargetRole GraspSession::targetRole(uint64_t id) const {
 }
 
 Status GraspSession::placeTarget(uint64_t id, uint64_t space, const Pose& spaceFromObject) {
+  if (isDepthTarget(id)) return Status::invalid_argument;  // placed by the session
   auto it = targets_.find(id);
   if (it == targets_.end()) return Status::invalid_argument;
   Target& t = it->second;
@@ -157,6 +159,7 @@ Status GraspSession::placeTarget(uint64_t id, uint64_t space, const Pose& spaceF
 }
 
 Status GraspSession::unplaceTarget(uint64_t id) {
+  if (isDepthTarget(id)) return Status::invalid_argument;  // placed by the session
   auto it = targets_.find(id);
   if (it == targets_.end()) return Status::invalid_argument;
   it->second.placed = false;
@@ -189,6 +192,7 @@ void GraspSession::reindex(uint64_t id, Target& t) {
 }
 
 Status GraspSession::updateTargetBounds(uint64_t id, const Aabb& bounds) {
+  if (isDepthTarget(id)) return Status::invalid_argument;  // placed by the session
   auto it = targets_.find(id);
   if (it == targets_.end() || it->second.meshTarget) return Status::invalid_argument;
   if (!validBounds(bounds)) return Status::invalid_argument;
@@ -268,6 +272,7 @@ std::vector<glm::vec3> GraspSession::vertexBuffer(uint64_t id) {
 }
 
 bool GraspSession::removeTarget(uint64_t id) {
+  if (isDepthTarget(id)) return false;  // the session's own (enableDepthScene)
   for (size_t h = 0; h < 2; ++h) {
     HandState& hand = hands_[h];
     // The hand lets go of a target it holds, and of a grab not yet decided that saw it (a squeeze

@@ -1,6 +1,7 @@
-// GraspWorker's thread: the queue of set-ups, jobs and outer-hand jobs, the order it takes them
-// in, and the hand-over of what it finished. The work itself: grasp_worker_targets.cpp (set-ups
-// and refits), grasp_worker_solve.cpp (fields, solves, the choice), grasp_worker_outer.cpp.
+// GraspWorker's thread: the queue of set-ups, jobs, outer-hand jobs and depth frames, the order it
+// takes them in, and the hand-over of what it finished. The work itself: grasp_worker_targets.cpp
+// (set-ups and refits), grasp_worker_solve.cpp (fields, solves, the choice),
+// grasp_worker_outer.cpp, grasp_worker_depth.cpp.
 #include "grasp/grasp_worker.h"
 
 #include "grasp/scene_exact_source.h"
@@ -101,7 +102,8 @@ void GraspWorker::run() {
     wake_.wait(lock, [&] { return stop_ || (!held_ && anyQueued()); });
     if (stop_) break;
     busy_ = true;
-    const bool otherWork = !setups_.empty() || slots_[0].queued || slots_[1].queued;
+    const bool otherWork =
+        !setups_.empty() || slots_[0].queued || slots_[1].queued || depth_.queued.has_value();
     if ((outer_[0].queued || outer_[1].queued) && !(lastRanOuter_ && otherWork)) {
       // The outer hand first: one frame's short solve, which the hand shows at once, before a
       // set-up or a build of a grab (milliseconds, up to seconds for a big mesh) that the hand
@@ -122,7 +124,7 @@ void GraspWorker::run() {
       setups_.pop_front();
       auto it = targets_.find(id);
       if (it != targets_.end() && it->second->setupMesh) runSetup(lock, id, it->second);
-    } else {
+    } else if (slots_[0].queued || slots_[1].queued) {
       // The slots take turns, so one hand's stream of re-solves cannot starve the other's grab.
       size_t slot = nextSlot_;
       if (!slots_[slot].queued) slot = 1 - slot;
@@ -131,6 +133,13 @@ void GraspWorker::run() {
       Job job = std::move(*slots_[slot].queued);
       slots_[slot].queued.reset();
       runJob(lock, slot, std::move(job));
+    } else {
+      // The depth scene last: a grab or an outer-hand job is what a hand waits for this frame;
+      // a frame of depth left for later is replaced by a newer one.
+      lastRanOuter_ = false;
+      DepthJob job = std::move(*depth_.queued);
+      depth_.queued.reset();
+      runDepth(lock, std::move(job));
     }
     busy_ = false;
     if (!anyQueued()) idle_.notify_all();
@@ -141,7 +150,7 @@ void GraspWorker::run() {
 
 bool GraspWorker::anyQueued() const {
   return !setups_.empty() || slots_[0].queued || slots_[1].queued || outer_[0].queued ||
-         outer_[1].queued;
+         outer_[1].queued || depth_.queued;
 }
 
 }  // namespace sdfg

@@ -11,7 +11,8 @@
 //   positions nobody builds with are never refit);
 // - request() leaves one job per hand slot (latest wins: a job not yet started is replaced, so the
 //   queue never grows); take() returns the newest finished result of a slot, if any, at once.
-// Set-ups run before hand jobs; the two slots take turns.
+// Set-ups run before hand jobs; the two slots take turns; a frame of the depth scene is fused
+// when nothing else waits (requestDepth()).
 //
 // Lifecycle: the destructor sets its stop flags, wakes the thread and joins it, and queued work
 // is dropped. Whatever runs then stops at its next look at a WorkLimit: a grab-box build at its
@@ -43,6 +44,7 @@
 #include "base/pose.h"
 #include "base/published.h"
 #include "base/status.h"
+#include "depth/depth_fusion.h"
 #include "grasp/contact.h"
 #include "grasp/hand_clearance.h"
 #include "grasp/outer_hand.h"
@@ -266,6 +268,35 @@ class GraspWorker {
   // owner ignores it.
   void resetOuter(size_t slot);
 
+  // The depth scene (depth/depth_fusion.h): one frame of the app's depth, fused into one volume
+  // per slot around where that hand is. Fused when nothing else waits (a grab, a set-up or an
+  // outer-hand job goes first), the newest frame replacing one not yet started: a worker slower
+  // than the frames fuses fewer of them, never a backlog.
+  struct DepthJob {
+    std::vector<DepthView> views;
+    std::vector<std::vector<float>> depth;  // views[i]'s stored values (DepthFusion::integrate)
+    // Where each slot's cube is centred (world); nothing: that volume is left as it is.
+    std::array<std::optional<glm::vec3>, kSlots> centres{};
+    std::vector<DepthExclusion> hands;  // the spheres of every hand the app draws
+    double time = 0.0;                  // seconds, not decreasing
+  };
+  // What a slot's volume target is after the last frame fused.
+  struct DepthDone {
+    bool valid = false;       // a frame was fused
+    uint64_t version = 0;     // of the target (Resolved::version, Done::versions)
+    Aabb bounds;              // the volume's, world frame
+    size_t observed = 0;      // voxels observed and not forgotten
+    size_t refusedViews = 0;  // views of the frame that integrate() refused
+  };
+  // Registers the depth scene's targets, one per slot (ready at once; empty until their first
+  // frame), fused with `options`. Errors: invalid_argument (options refused, ids in use, or on
+  // already).
+  Status enableDepth(const std::array<uint64_t, kSlots>& ids, const DepthFusionOptions& options);
+  void requestDepth(DepthJob job);
+  // The state of every slot's volume after the newest frame fused since the last call, or
+  // nothing (none fused, or the lock busy at that instant: poll again); never waits.
+  std::optional<std::array<DepthDone, kSlots>> takeDepth();
+
   // While held, the worker starts no job (the one running finishes); queued jobs wait, newer
   // ones replace them as usual. For tests and tools that need a late worker (what a hand shows
   // while the worker's answer has not come) or a known order of jobs; the layer never holds it.
@@ -283,8 +314,10 @@ class GraspWorker {
     // Set when the target is removed or replaced, or the worker is destroyed: its set-up or
     // refit in flight stops (the object is dropped, so a half-refit one is never used again).
     std::atomic<bool> stop{false};
-    std::shared_ptr<MeshDistance> distance;           // touched by the worker thread only
-    std::optional<AnalyticShape> shape;               // a shape target (no mesh)
+    std::shared_ptr<MeshDistance> distance;  // touched by the worker thread only
+    std::optional<AnalyticShape> shape;      // a shape target (no mesh)
+    // A depth scene's volume (owned by its fusion; worker thread only, like `distance`).
+    const DistanceVolume* volume = nullptr;
     std::optional<TriangleMesh> setupMesh;            // waiting for its set-up
     std::optional<std::vector<glm::vec3>> positions;  // waiting for the next build
     // Used positions buffers, handed out again (spareBuffer). Three circulate for a mesh that
@@ -363,6 +396,7 @@ class GraspWorker {
   void runSetup(std::unique_lock<std::mutex>& lock, uint64_t id, std::shared_ptr<Target> target);
   void runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job job);
   void runOuter(std::unique_lock<std::mutex>& lock, size_t slot, OuterJob job);
+  void runDepth(std::unique_lock<std::mutex>& lock, DepthJob job);
   // Anything queued (the caller holds the mutex).
   bool anyQueued() const;
   // A job member as the exact source and the field read it: the target's mesh or shape (the
@@ -409,6 +443,14 @@ class GraspWorker {
   std::deque<uint64_t> setups_;
   std::array<Slot, kSlots> slots_;
   std::array<OuterSlot, kSlots> outer_;
+  struct DepthState {
+    bool enabled = false;
+    std::array<uint64_t, kSlots> ids{};
+    std::array<std::optional<DepthFusion>, kSlots> fusion;  // worker thread only once enabled
+    std::optional<DepthJob> queued;
+    std::array<DepthDone, kSlots> done{};
+    bool fresh = false;  // done changed since the last takeDepth()
+  } depth_;
   size_t nextSlot_ = 0;
   size_t nextOuter_ = 0;       // the outer slots take turns too
   bool lastRanOuter_ = false;  // a queued grab runs before the next outer job

@@ -31,7 +31,7 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
   OuterSlot& o = outer_[slot];
   const bool reset = o.reset;
   o.reset = false;
-  // The members as the exact source sees them (meshes and shapes; device targets have no CPU
+  // The members as the exact source sees them (meshes, shapes, volumes; device targets have no CPU
   // mesh and are not kept out), looked up under the lock and read outside it: only this thread
   // touches a target's distance structure.
   // A mesh the app deformed since is refit first, as a grasp job would: the hand is kept out of
@@ -46,7 +46,7 @@ void GraspWorker::runOuter(std::unique_lock<std::mutex>& lock, size_t slot, Oute
     auto it = targets_.find(m.target);
     if (it == targets_.end() || it->second->setup != TargetSetup::ready) continue;
     const Target& t = *it->second;
-    if (t.distance == nullptr && !t.shape) continue;
+    if (t.distance == nullptr && !t.shape && t.volume == nullptr) continue;
     keep.push_back(it->second);
     scene.push_back(sceneMember(m, t));
     if (t.positions && t.distance != nullptr) refits.push_back(resolve(m.target, it->second));

@@ -80,6 +80,7 @@ SceneMember GraspWorker::sceneMember(const JobMember& m, const Target& t) {
   out.id = m.target;
   out.mesh = t.distance.get();
   out.shape = t.shape ? &*t.shape : nullptr;
+  out.volume = t.volume;
   out.objectFromHand = m.objectFromHand;
   out.graspable = m.graspable;
   return out;
@@ -117,7 +118,9 @@ void GraspWorker::runJob(std::unique_lock<std::mutex>& lock, size_t slot, Job jo
     std::vector<size_t> sceneIndex;  // scene[k] is job.members[sceneIndex[k]]
     for (size_t i = 0; i < resolved.size(); ++i) {
       const Resolved& r = resolved[i];
-      if (r.target == nullptr || (r.target->distance == nullptr && !r.target->shape)) continue;
+      if (r.target == nullptr ||
+          (r.target->distance == nullptr && !r.target->shape && r.target->volume == nullptr))
+        continue;
       scene.push_back(sceneMember(job.members[i], *r.target));
       sceneIndex.push_back(i);
       if (scene.size() == kMaxSceneMembers) break;

@@ -51,6 +51,8 @@ class SceneIndex {
   // The spaces' poses for the queries that follow (replaces the last ones; spaces not listed are
   // not located). Copies them.
   void setSpaces(std::span<const SpaceFrame> spaces);
+  // Adds one located space to those of the last setSpaces() (the session's own, such as the world).
+  void locate(uint64_t space, const Pose& worldFromSpace) { located_[space] = worldFromSpace; }
   // Where a target is in the world now (nothing: unknown, or its space is not located).
   std::optional<Pose> worldFromObject(uint64_t target) const;
 

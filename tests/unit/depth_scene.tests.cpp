@@ -17,6 +17,7 @@
 
 #include "depth/depth_fusion.h"
 #include "depth/depth_view.h"
+#include "depth_reaches.h"
 #include "depth_render.h"
 #include "eval/approaching.h"
 #include "eval/evaluator.h"
@@ -278,31 +279,11 @@ TEST_CASE("Depth fusion: a hand closes on a mug it only saw as depth, and stays 
   auto solver = createSolver("ours");
   REQUIRE(solver.ok());
   REQUIRE((*solver)->prepare(hand, box, SolverOptions{}) == Status::ok);
-  TriangleMesh worldMug = scene.mug;
-  transformMesh(worldMug, scene.worldFromMug);
-  auto truth = ExactMeshQuery::create(worldMug);
-  REQUIRE(truth.ok());
-  TriangleMesh worldTable = scene.table;
-  transformMesh(worldTable, scene.worldFromTable);
-  auto tableQuery = ExactMeshQuery::create(worldTable);
-  REQUIRE(tableQuery.ok());
-  // The benchmark's placements on the mug (eval/placements.h: the palm facing a surface point 1
-  // to 4 cm off it), those with the open hand in the table left out, and of those the reaches a
-  // user makes: for a point the head sees (its surface turned toward the head), from above, the
-  // side or into the cup. (Reaching for the side the head does not see, the fingers stop on the
-  // prior's solid behind what is seen: early, never inside.)
+  const MugTruth truth = mugTruth(scene);
+  // Reaching for the side the head does not see, the fingers stop on the prior's solid behind
+  // what is seen: early, never inside (depth_reaches.h leaves those out).
   const int count = 60;
-  const glm::vec3 eye = view.worldFromView.position;
-  std::vector<Placement> placements;
-  for (const Placement& pl : generatePlacements(
-           worldMug, **truth, hand, box, 4 * count, 1, [&](const Pose& worldFromHand) {
-             return openHandIntersects(**tableQuery, hand, worldFromHand);
-           })) {
-    if (glm::dot(pl.normal, glm::normalize(eye - pl.surfacePoint)) > 0.2f &&
-        placements.size() < size_t(count))
-      placements.push_back(pl);
-  }
-  REQUIRE(placements.size() == size_t(count));
+  const std::vector<Placement> placements = seenReaches(truth, view, hand, box, count);
   const std::unique_ptr<SdfBackend> backend = makeCpuSdfBackend(1);
   int made = 0, touching = 0;
   std::vector<float> penetrations, residuals;
@@ -325,8 +306,8 @@ TEST_CASE("Depth fusion: a hand closes on a mug it only saw as depth, and stays 
     GraspResult result;
     REQUIRE((*solver)->solve(gs, result) == Status::ok);
     // Against the true surfaces: each finger's gap to the nearest of the mug and the table.
-    const GraspMetrics onMug = evaluateGrasp(**truth, hand, worldFromHand, result);
-    const GraspMetrics onTable = evaluateGrasp(**tableQuery, hand, worldFromHand, result);
+    const GraspMetrics onMug = evaluateGrasp(*truth.mug, hand, worldFromHand, result);
+    const GraspMetrics onTable = evaluateGrasp(*truth.table, hand, worldFromHand, result);
     int fingersTouching = 0;
     float graspDeepest = 0.0f;
     for (int fi = 0; fi < kFingerCount; ++fi) {

@@ -13,6 +13,7 @@
 #include <glm/geometric.hpp>
 #include <glm/gtx/quaternion.hpp>
 
+#include "depth_reaches.h"
 #include "depth_render.h"
 #include "eval/approaching.h"
 #include "eval/evaluator.h"
@@ -106,28 +107,10 @@ TEST_CASE("Depth scene: a hand squeezed by a mug it only saw as depth closes on 
   const MugOnTable scene;
   DepthRig rig(scene, /*outer=*/false);
   const GridBox box = GridBox::referenceDefault();
-  TriangleMesh worldMug = scene.mug;
-  transformMesh(worldMug, scene.worldFromMug);
-  auto truth = ExactMeshQuery::create(worldMug);
-  REQUIRE(truth.ok());
-  TriangleMesh worldTable = scene.table;
-  transformMesh(worldTable, scene.worldFromTable);
-  auto tableQuery = ExactMeshQuery::create(worldTable);
-  REQUIRE(tableQuery.ok());
-  // As depth_scene_tests has them: the benchmark's placements on the mug whose open hand is clear
-  // of the table and whose surface point the head sees.
+  const MugTruth truth = mugTruth(scene);
+  // As depth_scene_tests has them (depth_reaches.h).
   const int count = 20;
-  const glm::vec3 eye = rig.view.worldFromView.position;
-  std::vector<Placement> placements;
-  for (const Placement& pl : generatePlacements(
-           worldMug, **truth, rig.model, box, 4 * count, 1, [&](const Pose& worldFromHand) {
-             return openHandIntersects(**tableQuery, rig.model, worldFromHand);
-           })) {
-    if (glm::dot(pl.normal, glm::normalize(eye - pl.surfacePoint)) > 0.2f &&
-        placements.size() < size_t(count))
-      placements.push_back(pl);
-  }
-  REQUIRE(placements.size() == size_t(count));
+  const std::vector<Placement> placements = seenReaches(truth, rig.view, rig.model, box, count);
 
   int made = 0, heldDepth = 0, reportedContacts = 0;
   std::vector<float> penetrations, residuals;
@@ -149,8 +132,8 @@ TEST_CASE("Depth scene: a hand squeezed by a mug it only saw as depth closes on 
     REQUIRE(shown);
     const HandGrasp& g = rig.session.grasp(Hand::right);
     if (g.target == GraspSession::depthTarget(Hand::right)) ++heldDepth;
-    const GraspMetrics onMug = evaluateGrasp(**truth, rig.model, atObject, g.result);
-    const GraspMetrics onTable = evaluateGrasp(**tableQuery, rig.model, atObject, g.result);
+    const GraspMetrics onMug = evaluateGrasp(*truth.mug, rig.model, atObject, g.result);
+    const GraspMetrics onTable = evaluateGrasp(*truth.table, rig.model, atObject, g.result);
     int touching = 0;
     float deepest = 0.0f;
     for (int f = 0; f < kFingerCount; ++f) {

@@ -5,6 +5,8 @@
 // for what is in view, from above, the side or into the cup.
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -52,6 +54,36 @@ inline std::vector<Placement> seenReaches(const MugTruth& truth, const DepthView
   }
   REQUIRE(out.size() == size_t(count));
   return out;
+}
+
+// A grasp against the true surfaces: each finger's gap to the nearer of the mug and the table
+// (mm, negative inside), how many fingers touch one (within kTouchingMm), and the deepest any
+// finger entered either.
+struct TrueGrade {
+  std::array<float, kFingerCount> clearanceMm{};
+  int touching = 0;
+  float deepestMm = 0.0f;
+};
+
+inline TrueGrade gradeOnTruth(const MugTruth& truth, const HandModel& hand,
+                              const Pose& worldFromHand, const GraspResult& result) {
+  const GraspMetrics onMug = evaluateGrasp(*truth.mug, hand, worldFromHand, result);
+  const GraspMetrics onTable = evaluateGrasp(*truth.table, hand, worldFromHand, result);
+  TrueGrade g;
+  for (int f = 0; f < kFingerCount; ++f) {
+    const FingerMetrics& m = onMug.fingers[size_t(f)];
+    const FingerMetrics& t = onTable.fingers[size_t(f)];
+    g.clearanceMm[size_t(f)] = std::min(m.clearanceMm, t.clearanceMm);
+    g.deepestMm = std::max({g.deepestMm, m.penetrationMm, t.penetrationMm});
+    if (g.clearanceMm[size_t(f)] <= kTouchingMm) ++g.touching;
+  }
+  return g;
+}
+
+// The q-quantile of `v` (its element at q of the way through, sorted); 0 when empty.
+inline float quantile(std::vector<float> v, double q) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0f : v[size_t(q * double(v.size() - 1))];
 }
 
 }  // namespace sdfg::depth_test

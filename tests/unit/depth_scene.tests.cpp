@@ -306,26 +306,16 @@ TEST_CASE("Depth fusion: a hand closes on a mug it only saw as depth, and stays 
     GraspResult result;
     REQUIRE((*solver)->solve(gs, result) == Status::ok);
     // Against the true surfaces: each finger's gap to the nearest of the mug and the table.
-    const GraspMetrics onMug = evaluateGrasp(*truth.mug, hand, worldFromHand, result);
-    const GraspMetrics onTable = evaluateGrasp(*truth.table, hand, worldFromHand, result);
-    int fingersTouching = 0;
-    float graspDeepest = 0.0f;
-    for (int fi = 0; fi < kFingerCount; ++fi) {
-      const FingerMetrics& m = onMug.fingers[size_t(fi)];
-      const FingerMetrics& t = onTable.fingers[size_t(fi)];
-      const float clearance = std::min(m.clearanceMm, t.clearanceMm);
-      graspDeepest = std::max({graspDeepest, m.penetrationMm, t.penetrationMm});
-      if (clearance <= kTouchingMm) ++fingersTouching;
-      if (result.fingers[size_t(fi)].contact) residuals.push_back(std::abs(clearance));
-    }
+    const TrueGrade grade = gradeOnTruth(truth, hand, worldFromHand, result);
+    const int fingersTouching = grade.touching;
+    const float graspDeepest = grade.deepestMm;
+    for (int fi = 0; fi < kFingerCount; ++fi)
+      if (result.fingers[size_t(fi)].contact)
+        residuals.push_back(std::abs(grade.clearanceMm[size_t(fi)]));
     made += fingersTouching >= 2 ? 1 : 0;
     touching += fingersTouching;
     penetrations.push_back(graspDeepest);
   }
-  auto quantile = [](std::vector<float> v, double q) {
-    std::sort(v.begin(), v.end());
-    return v.empty() ? 0.0f : v[size_t(q * double(v.size() - 1))];
-  };
   const float penP99 = quantile(penetrations, 0.99), penMax = quantile(penetrations, 1.0);
   const float resMedian = quantile(residuals, 0.5), resP95 = quantile(residuals, 0.95);
   std::printf(

@@ -64,12 +64,6 @@ struct DepthRig {
   }
 };
 
-template <class T>
-T quantile(std::vector<T> v, double q) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? T{} : v[size_t(q * double(v.size() - 1))];
-}
-
 }  // namespace
 
 TEST_CASE("Depth scene: a session refuses depth it cannot read and depth while it is off",
@@ -132,22 +126,15 @@ TEST_CASE("Depth scene: a hand squeezed by a mug it only saw as depth closes on 
     REQUIRE(shown);
     const HandGrasp& g = rig.session.grasp(Hand::right);
     if (g.target == GraspSession::depthTarget(Hand::right)) ++heldDepth;
-    const GraspMetrics onMug = evaluateGrasp(*truth.mug, rig.model, atObject, g.result);
-    const GraspMetrics onTable = evaluateGrasp(*truth.table, rig.model, atObject, g.result);
-    int touching = 0;
-    float deepest = 0.0f;
+    const TrueGrade grade = gradeOnTruth(truth, rig.model, atObject, g.result);
     for (int f = 0; f < kFingerCount; ++f) {
-      const FingerMetrics& m = onMug.fingers[size_t(f)];
-      const FingerMetrics& t = onTable.fingers[size_t(f)];
-      const float clearance = std::min(m.clearanceMm, t.clearanceMm);
-      deepest = std::max({deepest, m.penetrationMm, t.penetrationMm});
-      if (clearance <= kTouchingMm) ++touching;
-      if (g.result.fingers[size_t(f)].contact) {
-        residuals.push_back(std::abs(clearance));
-        // What a finger touches is said: the depth scene, not a target of the caller's.
-        if (g.touched[size_t(f)] == GraspSession::depthTarget(Hand::right)) ++reportedContacts;
-      }
+      if (!g.result.fingers[size_t(f)].contact) continue;
+      residuals.push_back(std::abs(grade.clearanceMm[size_t(f)]));
+      // What a finger touches is said: the depth scene, not a target of the caller's.
+      if (g.touched[size_t(f)] == GraspSession::depthTarget(Hand::right)) ++reportedContacts;
     }
+    const int touching = grade.touching;
+    const float deepest = grade.deepestMm;
     made += touching >= 2 ? 1 : 0;
     penetrations.push_back(deepest);
     // Let go, and the next reach starts open.

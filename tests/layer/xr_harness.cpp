@@ -450,7 +450,11 @@ void App::frame(const std::function<void()>& beforeEnd) {
   XrFrameEndInfo ei{XR_TYPE_FRAME_END_INFO};
   ei.displayTime = fs.predictedDisplayTime;
   ei.environmentBlendMode = XR_ENVIRONMENT_BLEND_MODE_OPAQUE;
-  if (xrEndFrame(session, &ei) == XR_SUCCESS) ++framesEnded;
+  ei.layerCount = uint32_t(layers.size());
+  ei.layers = layers.empty() ? nullptr : layers.data();
+  lastEndFrame = xrEndFrame(session, &ei);
+  layers.clear();
+  if (lastEndFrame == XR_SUCCESS) ++framesEnded;
 }
 
 float App::appSqueezeValue(int hand) const {

@@ -95,6 +95,11 @@ class App {
   uint64_t framesEnded = 0;
   XrResult lastSync = XR_SUCCESS;
   std::vector<XrEventDataBuffer> events;  // every event frame() polled, in order
+  // The composition layers of the frame being made, for xrEndFrame: `beforeEnd` fills it (a
+  // DepthSubmitter does); frame() empties it after xrEndFrame, so no frame submits pointers into
+  // an earlier frame's structs. Empty: no layers, as an app that renders nothing.
+  std::vector<const XrCompositionLayerBaseHeader*> layers;
+  XrResult lastEndFrame = XR_SUCCESS;  // what the last frame's xrEndFrame returned
 
   template <class F>
   F fn(const char* name) const {
@@ -113,12 +118,14 @@ class App {
   // Tests wait for an outcome this way, never for a number of frames: how many frames a build
   // takes depends on the machine (a cold shader cache, cores busy with other work). The 1 ms
   // between frames lets lavapipe's and the layer's threads run; the layer never waits itself.
+  // `beforeEnd` runs in every frame, as in frame().
   template <class Done>
-  bool framesUntil(Done done, std::chrono::milliseconds limit = std::chrono::seconds(120)) {
+  bool framesUntil(Done done, std::chrono::milliseconds limit = std::chrono::seconds(120),
+                   const std::function<void()>& beforeEnd = {}) {
     const auto end = std::chrono::steady_clock::now() + limit;
     while (!done()) {
       if (std::chrono::steady_clock::now() > end) return false;
-      frame();
+      frame(beforeEnd);
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
     return true;

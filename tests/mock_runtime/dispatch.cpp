@@ -140,6 +140,7 @@ const std::vector<Command>& commands() {
       MOCK_COMMAND(xrLocateHandJointsEXT, locateHandJoints, handTracking),
       MOCK_COMMAND(xrMockRuntimeSetScriptSDFG, mockSetScript, test),
       MOCK_COMMAND(xrMockRuntimeGetStatsSDFG, mockGetStats, test),
+      MOCK_COMMAND(xrMockRuntimeGetDepthStatsSDFG, mockGetDepthStats, test),
       MOCK_COMMAND(xrMockRuntimeGetCaptureSDFG, mockGetCapture, test),
       MOCK_COMMAND(xrMockRuntimeGateCallsSDFG, mockGateCalls, test),
       MOCK_COMMAND(xrMockRuntimeGateStatsSDFG, mockGateStats, test),

@@ -137,6 +137,7 @@ XrResult locateHandJoints(XrHandTrackerEXT tracker, const XrHandJointsLocateInfo
 // test_functions.cpp and instance.cpp (mock_runtime_test.h)
 XrResult mockSetScript(XrInstance instance, const char* scriptText);
 XrResult mockGetStats(XrSession session, XrMockRuntimeStatsSDFG* stats);
+XrResult mockGetDepthStats(XrSession session, uint32_t* framesWithDepth, uint32_t* depthInfos);
 XrResult mockGateCalls(XrInstance instance, const char* command, XrBool32 hold,
                        uint32_t delayMicroseconds);
 XrResult mockGateStats(XrInstance instance, const char* command, uint32_t* waiting,

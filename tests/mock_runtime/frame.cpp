@@ -1,6 +1,7 @@
 // Frame loop: xrWaitFrame / xrBeginFrame / xrEndFrame with the spec's call-order errors,
 // layer validation, optional capture of the submitted images, and the N-frame end.
 #include <algorithm>
+#include <cmath>
 
 #include "entry_points.h"
 #include "pose_math.h"
@@ -28,6 +29,33 @@ XrResult verifySubImage(const char* cmd, const Session& session, const XrSwapcha
     return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "imageArrayIndex %u >= arraySize %u",
                 sub.imageArrayIndex, sc->info.arraySize);
   *out = sc;
+  return XR_SUCCESS;
+}
+
+bool notNegative(float v) {
+  return !std::isnan(v) && v >= 0.0f;
+}
+
+// Checks one XrCompositionLayerDepthInfoKHR (XR_KHR_composition_layer_depth): a depth swapchain
+// of this session with a released image, the sub-image inside it, a depth range inside [0, 1]
+// and two distinct planes, either of which may be at +infinity (reversed or infinite depth).
+XrResult verifyDepthInfo(const char* cmd, const Session& session,
+                         const XrCompositionLayerDepthInfoKHR& d, uint32_t view) {
+  Swapchain* sc = nullptr;
+  if (XrResult r = verifySubImage(cmd, session, d.subImage, &sc); r != XR_SUCCESS) return r;
+  if (!isDepthFormat(sc->info.format))
+    return fail(cmd, XR_ERROR_VALIDATION_FAILURE,
+                "views[%u] depth info: swapchain format %lld is no depth format", view,
+                (long long)sc->info.format);
+  if (!(d.minDepth >= 0.0f && d.minDepth <= 1.0f && d.maxDepth >= 0.0f && d.maxDepth <= 1.0f &&
+        d.minDepth < d.maxDepth))
+    return fail(cmd, XR_ERROR_VALIDATION_FAILURE,
+                "views[%u] depth info: minDepth %g, maxDepth %g (need 0 <= min < max <= 1)", view,
+                double(d.minDepth), double(d.maxDepth));
+  if (!notNegative(d.nearZ) || !notNegative(d.farZ) || d.nearZ == d.farZ)
+    return fail(cmd, XR_ERROR_VALIDATION_FAILURE,
+                "views[%u] depth info: nearZ %g, farZ %g (need two distinct planes >= 0)", view,
+                double(d.nearZ), double(d.farZ));
   return XR_SUCCESS;
 }
 
@@ -121,6 +149,7 @@ XrResult endFrame(XrSession handle, const XrFrameEndInfo* info) {
   if (info->layerCount > 0) MOCK_VERIFY_NOT_NULL(cmd, info->layers);
 
   const XrCompositionLayerProjection* firstProjection = nullptr;
+  uint32_t depthInfos = 0;  // counted once the whole frame is accepted
   for (uint32_t i = 0; i < info->layerCount; ++i) {
     const XrCompositionLayerBaseHeader* layer = info->layers[i];
     if (layer == nullptr) return fail(cmd, XR_ERROR_LAYER_INVALID, "layers[%u] is null", i);
@@ -139,6 +168,16 @@ XrResult endFrame(XrSession handle, const XrFrameEndInfo* info) {
           return fail(cmd, XR_ERROR_POSE_INVALID, "views[%u].pose", v);
         if (XrResult r = verifySubImage(cmd, *session, p->views[v].subImage, &sc); r != XR_SUCCESS)
           return r;
+        // Without the extension the struct is not the app's to chain, and a runtime skips
+        // what it does not know.
+        if (!session->instance->extDepth) continue;
+        for (auto* n = static_cast<const XrBaseInStructure*>(p->views[v].next); n != nullptr;
+             n = n->next) {
+          if (n->type != XR_TYPE_COMPOSITION_LAYER_DEPTH_INFO_KHR) continue;
+          const auto& d = *reinterpret_cast<const XrCompositionLayerDepthInfoKHR*>(n);
+          if (XrResult r = verifyDepthInfo(cmd, *session, d, v); r != XR_SUCCESS) return r;
+          ++depthInfos;
+        }
       }
       if (firstProjection == nullptr) firstProjection = p;
     } else if (layer->type == XR_TYPE_COMPOSITION_LAYER_QUAD) {
@@ -163,6 +202,8 @@ XrResult endFrame(XrSession handle, const XrFrameEndInfo* info) {
     if (captured) ++session->stats.framesCaptured;
   }
 
+  if (depthInfos > 0) ++session->framesWithDepth;
+  session->depthInfos += depthInfos;
   return finishFrame(*session, *info);
 }
 

@@ -37,6 +37,8 @@ std::vector<XrExtensionProperties> offeredExtensions() {
   add(XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME, XR_KHR_vulkan_enable2_SPEC_VERSION);
   add(XR_MND_HEADLESS_EXTENSION_NAME, XR_MND_headless_SPEC_VERSION);
   add(XR_KHR_CONVERT_TIMESPEC_TIME_EXTENSION_NAME, XR_KHR_convert_timespec_time_SPEC_VERSION);
+  // Revision 6, the current one; the SDK headers here say 5, with the same struct.
+  add(XR_KHR_COMPOSITION_LAYER_DEPTH_EXTENSION_NAME, 6);
   if (handTrackingFromEnv() != HandTrackingMode::absent) {
     add(XR_EXT_HAND_TRACKING_EXTENSION_NAME, XR_EXT_hand_tracking_SPEC_VERSION);
     add(XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME,
@@ -219,6 +221,7 @@ XrResult createInstance(const XrInstanceCreateInfo* info, XrInstance* out) {
     if (n == XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME) instance->extVulkan2 = true;
     if (n == XR_MND_HEADLESS_EXTENSION_NAME) instance->extHeadless = true;
     if (n == XR_KHR_CONVERT_TIMESPEC_TIME_EXTENSION_NAME) instance->extTimespec = true;
+    if (n == XR_KHR_COMPOSITION_LAYER_DEPTH_EXTENSION_NAME) instance->extDepth = true;
     if (n == XR_EXT_HAND_TRACKING_EXTENSION_NAME) instance->extHandTracking = true;
     if (n == XR_EXT_HAND_JOINTS_MOTION_RANGE_EXTENSION_NAME) instance->extMotionRange = true;
   }

@@ -36,7 +36,10 @@ extern "C" {
 // "skip_layout_transition": swapchain images stay in VK_IMAGE_LAYOUT_UNDEFINED (the Vulkan
 // validation layer then reports the app's render pass);
 // "zero_display_time": xrWaitFrame predicts a display time of 0 and xrEndFrame accepts 0, as
-// Monado does in headless sessions.
+// Monado does in headless sessions;
+// "refuse_depth_readback": xrCreateSwapchain of a depth format fails with
+// XR_ERROR_FEATURE_UNSUPPORTED when usageFlags has TRANSFER_SRC or SAMPLED (the same create
+// without them succeeds), as a runtime whose depth images only its compositor may read.
 #define SDFG_MOCK_ENV_FAULT "SDFG_MOCK_FAULT"
 // "1": log every error the runtime returns, and why, on stderr.
 #define SDFG_MOCK_ENV_LOG "SDFG_MOCK_LOG"
@@ -70,6 +73,17 @@ typedef XrResult(XRAPI_PTR* PFN_xrMockRuntimeSetScriptSDFG)(XrInstance instance,
 // Fills `stats` (caller-owned) for `session`.
 typedef XrResult(XRAPI_PTR* PFN_xrMockRuntimeGetStatsSDFG)(XrSession session,
                                                            XrMockRuntimeStatsSDFG* stats);
+
+// XR_KHR_composition_layer_depth in `session`, counted in xrEndFrame calls that succeeded and
+// only when the app enabled the extension (otherwise depth infos are ignored): the frames with
+// at least one XrCompositionLayerDepthInfoKHR chained on a projection view, and how many such
+// infos there were in all. Each one was checked (a depth swapchain of the session with a
+// released image, rect inside it, 0 <= minDepth < maxDepth <= 1, nearZ != farZ, both >= 0 and
+// not NaN; either may be +infinity). Errors: XR_ERROR_HANDLE_INVALID, XR_ERROR_VALIDATION_FAILURE
+// (a null pointer).
+typedef XrResult(XRAPI_PTR* PFN_xrMockRuntimeGetDepthStatsSDFG)(XrSession session,
+                                                                uint32_t* framesWithDepth,
+                                                                uint32_t* depthInfos);
 
 // Copies the last captured image of projection view `viewIndex` (0 left, 1 right) as tightly
 // packed RGBA8 rows, top row first, into `rgba` (caller-owned, `capacityBytes` bytes). Two-call

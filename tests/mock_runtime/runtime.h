@@ -146,6 +146,7 @@ struct Instance final : Object {
 
   bool extVulkan = false, extVulkan2 = false, extHandTracking = false, extHeadless = false,
        extMotionRange = false, extTimespec = false;
+  bool extDepth = false;  // XR_KHR_composition_layer_depth: depth infos are checked and counted
   HandTrackingMode handTracking = HandTrackingMode::supported;
   bool systemFetched = false;
   bool graphicsRequirementsQueried = false;
@@ -246,6 +247,9 @@ struct Session final : Object {
   bool profileChangePending = false;  // attached: INTERACTION_PROFILE_CHANGED at the next sync
   XrTime lastPredicted = 0;
   XrMockRuntimeStatsSDFG stats{};
+  // XR_KHR_composition_layer_depth, in accepted frames only (xrMockRuntimeGetDepthStatsSDFG).
+  uint32_t framesWithDepth = 0;  // frames with at least one depth info
+  uint32_t depthInfos = 0;       // depth infos, all views and layers
 
   VulkanContextPtr vulkan;  // null: headless session
   std::vector<std::unique_ptr<Space>> spaces;
@@ -345,7 +349,13 @@ int subactionSlot(const Instance& instance, XrPath path);  // 0, 1, 2 (null), -1
 XrResult createVulkanContext(const char* cmd, Instance& instance,
                              const XrGraphicsBindingVulkanKHR& binding, VulkanContextPtr& out);
 void destroyVulkanContext(VulkanContext* context);
-const std::vector<int64_t>& vulkanSwapchainFormats();
+// The formats a Vulkan session offers, preferred first: fixed colour formats, then the depth
+// formats its physical device can attach (found at session creation).
+const std::vector<int64_t>& vulkanSwapchainFormats(const Session& session);
+inline bool isDepthFormat(int64_t f) {
+  return f == VK_FORMAT_D32_SFLOAT || f == VK_FORMAT_D16_UNORM ||
+         f == VK_FORMAT_D24_UNORM_S8_UINT || f == VK_FORMAT_D32_SFLOAT_S8_UINT;
+}
 XrResult createVulkanImages(const char* cmd, Swapchain& swapchain);
 void destroyVulkanImages(Swapchain& swapchain);
 XrResult prepareVulkanImage(const char* cmd, Swapchain& swapchain, uint32_t index);

@@ -14,11 +14,6 @@ constexpr XrSwapchainUsageFlags kKnownUsage =
     XR_SWAPCHAIN_USAGE_TRANSFER_DST_BIT | XR_SWAPCHAIN_USAGE_SAMPLED_BIT |
     XR_SWAPCHAIN_USAGE_MUTABLE_FORMAT_BIT | XR_SWAPCHAIN_USAGE_INPUT_ATTACHMENT_BIT_MND;
 
-bool isDepthFormat(int64_t f) {
-  return f == VK_FORMAT_D32_SFLOAT || f == VK_FORMAT_D16_UNORM ||
-         f == VK_FORMAT_D24_UNORM_S8_UINT || f == VK_FORMAT_D32_SFLOAT_S8_UINT;
-}
-
 }  // namespace
 
 Swapchain::~Swapchain() = default;
@@ -36,7 +31,7 @@ XrResult enumerateSwapchainFormats(XrSession handle, uint32_t capacity, uint32_t
   const Session* session = lookup<Session>(handle);
   if (session == nullptr) return fail(cmd, XR_ERROR_HANDLE_INVALID, "session is not valid");
   if (!session->vulkan) return twoCall<int64_t>(cmd, capacity, countOutput, formats, nullptr, 0);
-  const std::vector<int64_t>& list = vulkanSwapchainFormats();
+  const std::vector<int64_t>& list = vulkanSwapchainFormats(*session);
   return twoCall(cmd, capacity, countOutput, formats, list.data(), uint32_t(list.size()));
 }
 
@@ -55,7 +50,7 @@ XrResult createSwapchain(XrSession handle, const XrSwapchainCreateInfo* info, Xr
   if (info->usageFlags & ~kKnownUsage)
     return fail(cmd, XR_ERROR_VALIDATION_FAILURE, "unknown usageFlags");
   if (!session->vulkan) return fail(cmd, XR_ERROR_SWAPCHAIN_FORMAT_UNSUPPORTED, "headless session");
-  const auto& formats = vulkanSwapchainFormats();
+  const auto& formats = vulkanSwapchainFormats(*session);
   if (std::find(formats.begin(), formats.end(), info->format) == formats.end())
     return fail(cmd, XR_ERROR_SWAPCHAIN_FORMAT_UNSUPPORTED, "format %lld", (long long)info->format);
   if (info->sampleCount == 0 || info->width == 0 || info->height == 0 || info->faceCount == 0 ||
@@ -72,6 +67,13 @@ XrResult createSwapchain(XrSession handle, const XrSwapchainCreateInfo* info, Xr
   if ((depth && (info->usageFlags & XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT)) ||
       (!depth && (info->usageFlags & XR_SWAPCHAIN_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT)))
     return fail(cmd, XR_ERROR_FEATURE_UNSUPPORTED, "usage does not fit the format");
+  // Fault "refuse_depth_readback": a runtime that cannot let anyone read its depth images (some
+  // compositors allocate them for attachment only), so a layer that adds a read usage to an
+  // app's depth swapchain must fall back to the app's own flags.
+  if (depth && session->instance->options.fault == "refuse_depth_readback" &&
+      (info->usageFlags & (XR_SWAPCHAIN_USAGE_TRANSFER_SRC_BIT | XR_SWAPCHAIN_USAGE_SAMPLED_BIT)))
+    return fail(cmd, XR_ERROR_FEATURE_UNSUPPORTED,
+                "fault refuse_depth_readback: depth swapchains cannot be read");
 
   auto swapchain = std::make_unique<Swapchain>();
   swapchain->session = session;

@@ -17,6 +17,17 @@ XrResult mockGetStats(XrSession handle, XrMockRuntimeStatsSDFG* stats) {
   return XR_SUCCESS;
 }
 
+XrResult mockGetDepthStats(XrSession handle, uint32_t* framesWithDepth, uint32_t* depthInfos) {
+  constexpr const char* cmd = "xrMockRuntimeGetDepthStatsSDFG";
+  const Session* session = lookup<Session>(handle);
+  if (session == nullptr) return fail(cmd, XR_ERROR_HANDLE_INVALID, "session is not valid");
+  MOCK_VERIFY_NOT_NULL(cmd, framesWithDepth);
+  MOCK_VERIFY_NOT_NULL(cmd, depthInfos);
+  *framesWithDepth = session->framesWithDepth;
+  *depthInfos = session->depthInfos;
+  return XR_SUCCESS;
+}
+
 XrResult mockGetCapture(XrSession handle, uint32_t viewIndex, uint32_t capacityBytes,
                         uint32_t* width, uint32_t* height, uint8_t* rgba) {
   constexpr const char* cmd = "xrMockRuntimeGetCaptureSDFG";

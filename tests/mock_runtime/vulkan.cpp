@@ -25,6 +25,7 @@ struct VulkanContext {
   VkBuffer readback = VK_NULL_HANDLE;         // host-visible target of image captures
   VkDeviceMemory readbackMemory = VK_NULL_HANDLE;
   VkDeviceSize readbackSize = 0;
+  std::vector<int64_t> formats;  // xrEnumerateSwapchainFormats: what this device can make
 };
 
 namespace {
@@ -40,15 +41,10 @@ bool findMemoryType(const VulkanContext& vk, uint32_t typeBits, VkMemoryProperty
   return false;
 }
 
-bool isDepth(VkFormat f) {
-  return f == VK_FORMAT_D32_SFLOAT || f == VK_FORMAT_D16_UNORM ||
-         f == VK_FORMAT_D24_UNORM_S8_UINT || f == VK_FORMAT_D32_SFLOAT_S8_UINT;
-}
-
 VkImageAspectFlags aspectOf(VkFormat f) {
   if (f == VK_FORMAT_D24_UNORM_S8_UINT || f == VK_FORMAT_D32_SFLOAT_S8_UINT)
     return VK_IMAGE_ASPECT_DEPTH_BIT | VK_IMAGE_ASPECT_STENCIL_BIT;
-  return isDepth(f) ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
+  return isDepthFormat(f) ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
 }
 
 // Records into the context's command buffer, submits it on the app's queue and waits.
@@ -90,14 +86,28 @@ XrResult verifySystemId(const char* cmd, const Instance& instance, XrSystemId sy
   return XR_SUCCESS;
 }
 
+// Preferred first, as the spec asks: sRGB colour, then UNORM, then depth. D32_SFLOAT is offered
+// as it always was (Vulkan guarantees it or X8_D24 as an attachment, and every device the tests
+// meet has it); the others only where the device can attach them, since an app that picks an
+// offered format must be able to render into it.
+std::vector<int64_t> offeredFormats(VkPhysicalDevice device) {
+  std::vector<int64_t> formats = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_B8G8R8A8_SRGB,
+                                  VK_FORMAT_R8G8B8A8_UNORM, VK_FORMAT_B8G8R8A8_UNORM,
+                                  VK_FORMAT_D32_SFLOAT};
+  for (VkFormat f :
+       {VK_FORMAT_D16_UNORM, VK_FORMAT_D24_UNORM_S8_UINT, VK_FORMAT_D32_SFLOAT_S8_UINT}) {
+    VkFormatProperties props{};
+    vkGetPhysicalDeviceFormatProperties(device, f, &props);
+    if (props.optimalTilingFeatures & VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT)
+      formats.push_back(f);
+  }
+  return formats;
+}
+
 }  // namespace
 
-const std::vector<int64_t>& vulkanSwapchainFormats() {
-  // Preferred first, as the spec asks; sRGB colour, then UNORM, then depth.
-  static const std::vector<int64_t> formats = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_B8G8R8A8_SRGB,
-                                               VK_FORMAT_R8G8B8A8_UNORM, VK_FORMAT_B8G8R8A8_UNORM,
-                                               VK_FORMAT_D32_SFLOAT};
-  return formats;
+const std::vector<int64_t>& vulkanSwapchainFormats(const Session& session) {
+  return session.vulkan->formats;
 }
 
 XrResult createVulkanContext(const char* cmd, Instance& instance,
@@ -125,6 +135,7 @@ XrResult createVulkanContext(const char* cmd, Instance& instance,
   vk->queueFamily = binding.queueFamilyIndex;
   vkGetDeviceQueue(vk->device, binding.queueFamilyIndex, binding.queueIndex, &vk->queue);
   vkGetPhysicalDeviceMemoryProperties(vk->physicalDevice, &vk->memory);
+  vk->formats = offeredFormats(vk->physicalDevice);
   VkCommandPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   poolInfo.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
   poolInfo.queueFamilyIndex = vk->queueFamily;
@@ -244,7 +255,7 @@ XrResult prepareVulkanImage(const char* cmd, Swapchain& sc, uint32_t index) {
   }
   VulkanContext& vk = *sc.session->vulkan;
   const VkFormat format = VkFormat(sc.info.format);
-  const bool depth = isDepth(format);
+  const bool depth = isDepthFormat(format);
   const VkResult r = submitAndWait(vk, [&](VkCommandBuffer cb) {
     // UNDEFINED -> the layout XR_KHR_vulkan_enable promises after xrWaitSwapchainImage;
     // orders the transition before anything the app records on this queue later.

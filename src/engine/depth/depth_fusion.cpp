@@ -147,14 +147,20 @@ Status DepthFusion::integrate(const DepthView& view, std::span<const float> dept
         const float fx = (v.x / zx - tl) * sx, fy = (tu - v.y / zx) * sy;
         if (!(fx >= float(x0) && fx < float(x1) && fy >= float(y0) && fy < float(y1))) continue;
         const size_t px = size_t(fy) * view.width + size_t(fx);
-        if (handMask_[px] != 0) continue;
+        const size_t n = index(i, j, k);
+        // Behind the hand's own pixels the scene is hidden, not gone: what was fused there stays
+        // as fresh as if seen (a hand resting on an object for a second would otherwise have the
+        // surface under it forgotten, though nothing showed it leave).
+        if (handMask_[px] != 0) {
+          if (weight_[n] > 0.0f) seen_[n] = time;
+          continue;
+        }
         const float zs = view.distance(depth[px]);
         if (std::isnan(zs)) continue;  // a value the view cannot hold: no observation
         // Along the ray, not the axis: the voxel's distance from the surface its pixel saw.
         const float along = (zs - zx) * (glm::length(v) / zx);
         if (along < behind) continue;  // farther behind than the prior: unobserved
         const float obs = std::clamp(along, -tau, tau);
-        const size_t n = index(i, j, k);
         const float w = weight_[n];
         value_[n] = (value_[n] * w + obs) / (w + 1.0f);
         weight_[n] = std::min(w + 1.0f, maxWeight);

@@ -12,7 +12,8 @@
 //  - farther behind: not observed (the voxel keeps what it had).
 // Pixels whose surface point lies within the hand's exclusion spheres (the shown hand's joints,
 // grown by `handMargin`) are the hand the app drew, not the scene: their rays observe nothing, so
-// what was fused before the hand came stays. Observations are averaged with a capped weight
+// what was fused before the hand came stays, and is never forgotten while the hand hides it.
+// Observations are averaged with a capped weight
 // (`maxWeight` frames), so a surface that moves is followed within a few frames, and a voxel not
 // observed for `forgetAfter` seconds is forgotten (read as free), so a moved object leaves no
 // ghost where nothing looks any more.

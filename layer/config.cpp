@@ -54,7 +54,8 @@ const char* const kKeys[] = {"log_level",
                              "build_time_limit_ms",
                              "outer_hand",
                              "outer_release_distance",
-                             "outer_blend_time"};
+                             "outer_blend_time",
+                             "depth_scene"};
 
 }  // namespace
 
@@ -97,6 +98,16 @@ bool applyConfigValue(Config& config, const std::string& key, const std::string&
       ok = true;
     } else if (parseBool(value, flag)) {
       c.gpu = flag ? Config::Gpu::on : Config::Gpu::off;
+      ok = true;
+    }
+  } else if (key == "depth_scene") {
+    bool flag = false;
+    ok = false;
+    if (value == "auto") {
+      c.depthScene = Config::DepthScene::automatic;
+      ok = true;
+    } else if (parseBool(value, flag)) {
+      c.depthScene = flag ? Config::DepthScene::on : Config::DepthScene::off;
       ok = true;
     }
   } else if (key == "extra_queue") {

@@ -58,6 +58,13 @@ struct Config {
   float offsetBlendTime = 0.1f;
   // The outer hand (docs/layer.md, "The outer hand"): outer_hand, outer_release_distance
   // (metres), outer_blend_time (seconds).
+  // depth_scene (docs/depth.md): the scene from the depth a Vulkan app submits with
+  // XR_KHR_composition_layer_depth. auto: for apps that do not use XR_SDFG_auto_grasp (an app
+  // that registers its targets has its scene); on: for every app that submits depth, its
+  // registered targets and the depth together; off: never (depth swapchains are created exactly
+  // as the app asks).
+  enum class DepthScene { automatic, on, off };
+  DepthScene depthScene = DepthScene::automatic;
   bool outerHand = true;
   float outerReleaseDistance = 0.10f;
   float outerBlendTime = 0.25f;

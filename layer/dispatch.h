@@ -17,6 +17,11 @@ namespace sdfg::layer {
   X(xrWaitFrame)                         \
   X(xrBeginFrame)                        \
   X(xrEndFrame)                          \
+  X(xrCreateSwapchain)                   \
+  X(xrDestroySwapchain)                  \
+  X(xrEnumerateSwapchainImages)          \
+  X(xrAcquireSwapchainImage)             \
+  X(xrReleaseSwapchainImage)             \
   X(xrCreateVulkanInstanceKHR)           \
   X(xrCreateVulkanDeviceKHR)             \
   X(xrCreateReferenceSpace)              \

@@ -123,14 +123,14 @@ void noteGraspChange(SessionState& s, Hand hand, bool wasGrasping, uint64_t wasT
   e.hand = hand == Hand::left ? XR_HAND_LEFT_EXT : XR_HAND_RIGHT_EXT;
   e.time = s.predictedTime;
   if (wasGrasping && (!grasping || target != wasTarget)) {
-    e.target = fromKey<XrGraspTargetSDFG>(wasTarget);
+    e.target = appTarget(wasTarget);
     e.isGrasping = XR_FALSE;
     e.reason = destroyed ? XR_GRASP_CHANGE_REASON_TARGET_DESTROYED_SDFG
                          : XR_GRASP_CHANGE_REASON_RELEASED_SDFG;
     inst.events.push(e);
   }
   if (grasping && (!wasGrasping || target != wasTarget)) {
-    e.target = fromKey<XrGraspTargetSDFG>(target);
+    e.target = appTarget(target);
     e.isGrasping = XR_TRUE;
     e.reason = XR_GRASP_CHANGE_REASON_GRABBED_SDFG;
     inst.events.push(e);

@@ -611,7 +611,7 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
   const HandGrasp& g = s->grasp->grasp(hand);
   const bool held = g.holdsTarget();
   state->isGrasping = held ? XR_TRUE : XR_FALSE;
-  state->target = held ? fromKey<XrGraspTargetSDFG>(g.target) : XR_NULL_HANDLE;
+  state->target = held ? appTarget(g.target) : XR_NULL_HANDLE;
   state->squeeze = s->squeeze[hand == Hand::left ? 0 : 1];
   for (int f = 0; f < kFingerCount; ++f) {
     XrGraspFingerStateSDFG& out = state->fingers[f];
@@ -656,6 +656,17 @@ XrResult XRAPI_CALL SdfgXrGetGraspStateSDFG(XrSession session,
     setup->readyCount = uint32_t(counts.ready);
     setup->pendingCount = uint32_t(counts.pending);
     setup->failedCount = uint32_t(counts.failed);
+  }
+  if (auto* depth = findInChain<XrGraspDepthSceneInfoSDFG>(state->next,
+                                                           XR_TYPE_GRASP_DEPTH_SCENE_INFO_SDFG)) {
+    depth->enabled = s->depth != nullptr ? XR_TRUE : XR_FALSE;
+    depth->framesRead = 0;
+    if (s->depth != nullptr) {
+      std::lock_guard depthLock(s->depth->mutex);  // after the session's: the one order taken
+      depth->framesRead = uint32_t(std::min<uint64_t>(s->depth->framesSubmitted, UINT32_MAX));
+    }
+    depth->ready =
+        s->grasp->depthSceneEnabled() && s->grasp->depthState(hand).valid ? XR_TRUE : XR_FALSE;
   }
   writeHandOffset(*s, hand == Hand::left ? 0 : 1, state->next);
   return XR_SUCCESS;

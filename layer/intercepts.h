@@ -20,6 +20,13 @@ XrResult XRAPI_CALL SdfgXrDestroySpace(XrSpace);
 // vulkan.cpp
 XrResult XRAPI_CALL SdfgXrBeginFrame(XrSession, const XrFrameBeginInfo*);
 XrResult XRAPI_CALL SdfgXrEndFrame(XrSession, const XrFrameEndInfo*);
+XrResult XRAPI_CALL SdfgXrCreateSwapchain(XrSession, const XrSwapchainCreateInfo*, XrSwapchain*);
+XrResult XRAPI_CALL SdfgXrDestroySwapchain(XrSwapchain);
+XrResult XRAPI_CALL SdfgXrEnumerateSwapchainImages(XrSwapchain, uint32_t, uint32_t*,
+                                                   XrSwapchainImageBaseHeader*);
+XrResult XRAPI_CALL SdfgXrAcquireSwapchainImage(XrSwapchain, const XrSwapchainImageAcquireInfo*,
+                                                uint32_t*);
+XrResult XRAPI_CALL SdfgXrReleaseSwapchainImage(XrSwapchain, const XrSwapchainImageReleaseInfo*);
 XrResult XRAPI_CALL SdfgXrCreateVulkanInstanceKHR(XrInstance, const XrVulkanInstanceCreateInfoKHR*,
                                                   VkInstance*, VkResult*);
 XrResult XRAPI_CALL SdfgXrCreateVulkanDeviceKHR(XrInstance, const XrVulkanDeviceCreateInfoKHR*,

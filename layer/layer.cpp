@@ -146,6 +146,7 @@ XrResult XRAPI_CALL SdfgXrCreateApiLayerInstance(const XrInstanceCreateInfo* inf
   state->appDataSource = contains(appExtensions, XR_EXT_HAND_TRACKING_DATA_SOURCE_EXTENSION_NAME);
   state->appDebugUtils = contains(appExtensions, XR_EXT_DEBUG_UTILS_EXTENSION_NAME);
   state->appVulkan2 = contains(appExtensions, XR_KHR_VULKAN_ENABLE2_EXTENSION_NAME);
+  state->appDepthLayer = contains(appExtensions, XR_KHR_COMPOSITION_LAYER_DEPTH_EXTENSION_NAME);
   const bool appTimespec = contains(appExtensions, XR_KHR_CONVERT_TIMESPEC_TIME_EXTENSION_NAME);
 
   // What the chain offers decides the list sent down. Only when nobody below answers the query
@@ -343,6 +344,11 @@ const Route kRoutes[] = {
     SDFG_ROUTE(XrWaitFrame, Gate::active),
     SDFG_ROUTE(XrBeginFrame, Gate::active),
     SDFG_ROUTE(XrEndFrame, Gate::active),
+    SDFG_ROUTE(XrCreateSwapchain, Gate::active),
+    SDFG_ROUTE(XrDestroySwapchain, Gate::active),
+    SDFG_ROUTE(XrEnumerateSwapchainImages, Gate::active),
+    SDFG_ROUTE(XrAcquireSwapchainImage, Gate::active),
+    SDFG_ROUTE(XrReleaseSwapchainImage, Gate::active),
     SDFG_ROUTE(XrCreateVulkanInstanceKHR, Gate::vulkan2),
     SDFG_ROUTE(XrCreateVulkanDeviceKHR, Gate::vulkan2),
     SDFG_ROUTE(XrCreateReferenceSpace, Gate::active),

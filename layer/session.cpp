@@ -96,6 +96,8 @@ void endSessionWork(SessionState& s) {
     if (t != XR_NULL_HANDLE && s.instance->next.xrDestroyHandTrackerEXT != nullptr)
       s.instance->next.xrDestroyHandTrackerEXT(t);
   }
+  // The layer's depth copies on the app's device end before it may go (after the session).
+  endDepthCapture(s);
   // The worker stops what it runs within milliseconds and is joined here, on the thread that
   // destroys the session, holding no lock another call could need.
   grasp.reset();
@@ -180,6 +182,22 @@ XrResult XRAPI_CALL SdfgXrCreateSession(XrInstance instance, const XrSessionCrea
     s->vulkanBinding = *vk;
     s->vulkanBinding.next = nullptr;
   }
+  if (depthSceneWanted(*s)) {
+    s->depth = std::make_unique<SessionDepth>();
+  } else if (!s->vulkan && state->appDepthLayer &&
+             state->config.depthScene != Config::DepthScene::off) {
+    // docs/depth.md says what OpenGL, D3D11 and D3D12 sessions would take.
+    for (XrStructureType t :
+         {XR_TYPE_GRAPHICS_BINDING_OPENGL_WIN32_KHR, XR_TYPE_GRAPHICS_BINDING_OPENGL_XLIB_KHR,
+          XR_TYPE_GRAPHICS_BINDING_OPENGL_XCB_KHR, XR_TYPE_GRAPHICS_BINDING_OPENGL_WAYLAND_KHR,
+          XR_TYPE_GRAPHICS_BINDING_D3D11_KHR, XR_TYPE_GRAPHICS_BINDING_D3D12_KHR})
+      if (countInChain(info->next, t) > 0) {
+        SDFG_LOG_INFO(cmd,
+                      "the depth scene reads Vulkan sessions only: this session's depth is "
+                      "not read");
+        break;
+      }
+  }
   s->settings = settingsFromConfig(state->config);
   s->offsets.blendTime = state->config.offsetBlendTime;
   // Vulkan sessions build on the app's device (vulkan.cpp); the CPU builder is the fallback and
@@ -224,6 +242,7 @@ XrResult XRAPI_CALL SdfgXrDestroySession(XrSession session) {
     trackers().eraseIf([&](const TrackerState& t) { return t.session.lock() == s; });
     targets().eraseIf([&](const TargetState& t) { return t.session.lock() == s; });
     spaceOwners().eraseIf([&](const SessionState& owner) { return &owner == s.get(); });
+    swapchains().eraseIf([&](const SwapchainState& sc) { return sc.session.lock() == s; });
     sessions().erase(key(session));
     s->instance->events.dropSession(session);  // its grasp events would name a dead handle
   } else {

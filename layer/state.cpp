@@ -30,6 +30,11 @@ HandleMap<SessionState>& spaceOwners() {
   return map;
 }
 
+HandleMap<SwapchainState>& swapchains() {
+  static HandleMap<SwapchainState> map;
+  return map;
+}
+
 XrResult toXrResult(Status status) {
   switch (status) {
     case Status::ok:

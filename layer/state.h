@@ -21,6 +21,7 @@
 
 #include "base/published.h"
 #include "config.h"
+#include "depth_capture.h"
 #include "dispatch.h"
 #include "events.h"
 #include "grasp/grasp_session.h"
@@ -48,6 +49,13 @@ H fromKey(uint64_t value) {
     return reinterpret_cast<H>(value);
   else
     return static_cast<H>(value);
+}
+
+// The handle the app sees for an engine target id: the id itself (the layer's targets are keyed
+// by their handles), XR_GRASP_TARGET_DEPTH_SCENE_SDFG for either hand's depth scene.
+inline XrGraspTargetSDFG appTarget(uint64_t id) {
+  return GraspSession::isDepthTarget(id) ? XR_GRASP_TARGET_DEPTH_SCENE_SDFG
+                                         : fromKey<XrGraspTargetSDFG>(id);
 }
 
 // Handles the layer makes itself (hand trackers it synthesizes, grasp targets): non-canonical
@@ -106,6 +114,9 @@ struct InstanceState {
   // XR_KHR_vulkan_enable2: what the app's xrCreateVulkanInstanceKHR / xrCreateVulkanDeviceKHR
   // passed, and the queue the layer added to a device (see vulkan.cpp).
   bool appVulkan2 = false;
+  // XR_KHR_composition_layer_depth: the app may chain its depth on projection views, which the
+  // depth scene reads (depth_capture.h).
+  bool appDepthLayer = false;
   struct ExtraQueue {
     uint32_t family = 0;
     uint32_t index = 0;
@@ -175,6 +186,9 @@ struct SessionState {
   GraspSettings settings;
   std::unordered_map<uint64_t, std::shared_ptr<TargetState>> targets;
   HandOffsets offsets;  // the hands' offsets off their tracked poses (hand_offset.h)
+
+  // The depth scene's capture (depth_capture.h); null when the session cannot have one.
+  std::unique_ptr<SessionDepth> depth;
 
   // What each hand shows as of the last grab update (left, right): xrLocateHandJointsEXT draws
   // it without taking `mutex`, so a render thread never waits for the main thread's update.
@@ -264,6 +278,8 @@ HandleMap<TrackerState>& trackers();
 HandleMap<TargetState>& targets();
 // Space -> owning session, for spaces the app created through this layer.
 HandleMap<SessionState>& spaceOwners();
+// The app's swapchains (depth_capture.h).
+HandleMap<SwapchainState>& swapchains();
 
 // Maps a core Status to the XrResult the extension returns.
 XrResult toXrResult(Status status);
@@ -348,6 +364,13 @@ void updateInputAtFrame(SessionState& session);
 // layer is built without it, the config says gpu = false, or the device cannot be used; the
 // reason is logged): the engine's side of its mailbox. Sets session.gpu and session.ownQueue.
 std::unique_ptr<DeferredSdfBackend> makeVulkanBackend(SessionState& session);
+// vulkan.cpp: the app's Vulkan loader entry point for `vkInstance` (enable2: what the app passed
+// for it; enable: the loader in the process); null when there is none.
+PFN_vkGetInstanceProcAddr appVulkanGetInstanceProcAddr(InstanceState& inst, VkInstance vkInstance);
+#if SDFG_LAYER_VULKAN
+// The session's Vulkan binding as the engine borrows it, with the app's loader entry point.
+VulkanDevice appVulkanDevice(SessionState& session);
+#endif
 // Does the session's GPU calls (DeferredMailbox::pump): `inFrame` inside xrBeginFrame /
 // xrEndFrame (the app's queue is free), else only builds for the layer's own queue. Takes no
 // lock on entry, and none across the device calls; a pump running on another thread is not

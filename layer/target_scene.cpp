@@ -65,7 +65,7 @@ void writeTouches(const HandGrasp& g, XrGraspTouchesSDFG& out) {
   out.isClosed = g.shown() ? XR_TRUE : XR_FALSE;
   for (int f = 0; f < kFingerCount; ++f) {
     const uint64_t t = g.shown() ? g.touched[size_t(f)] : 0;
-    out.touched[f] = fromKey<XrGraspTargetSDFG>(t);
+    out.touched[f] = appTarget(t);
   }
 }
 

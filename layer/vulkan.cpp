@@ -33,17 +33,6 @@ std::shared_ptr<InstanceState> instanceOf(XrInstance handle) {
 }
 
 #if SDFG_LAYER_VULKAN
-// The app's Vulkan loader entry point for `vkInstance`.
-PFN_vkGetInstanceProcAddr appGetInstanceProcAddr(InstanceState& inst, VkInstance vkInstance) {
-  {
-    std::lock_guard lock(inst.vulkanMutex);
-    auto it = inst.vulkanGipa.find(key(vkInstance));
-    if (it != inst.vulkanGipa.end()) return it->second;
-  }
-  // Enable (v1): the loader the app linked (or loaded) is in the process already.
-  return reinterpret_cast<PFN_vkGetInstanceProcAddr>(platform::loadedVulkanGetInstanceProcAddr());
-}
-
 VkGraspFault faultFromConfig(const std::string& name) {
   if (name == "lost_at_submit") return VkGraspFault::lostAtSubmit;
   if (name == "lost_at_poll") return VkGraspFault::lostAtPoll;
@@ -54,6 +43,30 @@ VkGraspFault faultFromConfig(const std::string& name) {
 #endif
 
 }  // namespace
+
+PFN_vkGetInstanceProcAddr appVulkanGetInstanceProcAddr(InstanceState& inst, VkInstance vkInstance) {
+  {
+    std::lock_guard lock(inst.vulkanMutex);
+    auto it = inst.vulkanGipa.find(key(vkInstance));
+    if (it != inst.vulkanGipa.end()) return it->second;
+  }
+  // Enable (v1): the loader the app linked (or loaded) is in the process already.
+  return reinterpret_cast<PFN_vkGetInstanceProcAddr>(platform::loadedVulkanGetInstanceProcAddr());
+}
+
+#if SDFG_LAYER_VULKAN
+VulkanDevice appVulkanDevice(SessionState& s) {
+  const XrGraphicsBindingVulkanKHR& b = s.vulkanBinding;
+  VulkanDevice app;
+  app.instance = b.instance;
+  app.physicalDevice = b.physicalDevice;
+  app.device = b.device;
+  app.queueFamilyIndex = b.queueFamilyIndex;
+  app.queueIndex = b.queueIndex;
+  app.getInstanceProcAddr = appVulkanGetInstanceProcAddr(*s.instance, b.instance);
+  return app;
+}
+#endif
 
 std::unique_ptr<DeferredSdfBackend> makeVulkanBackend(SessionState& s) {
   constexpr const char* cmd = "xrCreateSession";
@@ -68,13 +81,7 @@ std::unique_ptr<DeferredSdfBackend> makeVulkanBackend(SessionState& s) {
     return nullptr;
   }
   const XrGraphicsBindingVulkanKHR& b = s.vulkanBinding;
-  VulkanDevice app;
-  app.instance = b.instance;
-  app.physicalDevice = b.physicalDevice;
-  app.device = b.device;
-  app.queueFamilyIndex = b.queueFamilyIndex;
-  app.queueIndex = b.queueIndex;
-  app.getInstanceProcAddr = appGetInstanceProcAddr(inst, b.instance);
+  const VulkanDevice app = appVulkanDevice(s);
   if (app.getInstanceProcAddr == nullptr) {
     SDFG_LOG_WARN(cmd, "no Vulkan loader in the process: grab-box SDFs on the CPU");
     return nullptr;
@@ -177,6 +184,9 @@ XrResult XRAPI_CALL SdfgXrBeginFrame(XrSession session, const XrFrameBeginInfo* 
 XrResult XRAPI_CALL SdfgXrEndFrame(XrSession session, const XrFrameEndInfo* info) {
   constexpr const char* cmd = "xrEndFrame";
   SDFG_ENTRY_BEGIN
+  // The depth the app submits with this frame (depth_capture.h); changes nothing passed down.
+  if (auto s = sessions().find(key(session)); s != nullptr && s->depth != nullptr)
+    captureDepthAtEndFrame(*s, info);
   return pumpThenCallDown(cmd, session, info, &NextDispatch::xrEndFrame);
   SDFG_ENTRY_END(cmd)
 }

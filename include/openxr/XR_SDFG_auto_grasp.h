@@ -647,6 +647,24 @@ typedef struct XrGraspTouchesSDFG {
   XrGraspTargetSDFG touched[XR_GRASP_FINGER_COUNT_SDFG];
 } XrGraspTouchesSDFG;
 
+// Optional output, chained on XrGraspStateSDFG::next: the depth scene near the hand (docs/depth.md;
+// config depth_scene). A grab closes on what the app drew only once `ready`; one that starts
+// before closes on what else is there.
+#define XR_TYPE_GRASP_DEPTH_SCENE_INFO_SDFG ((XrStructureType)1009900070)
+typedef struct XrGraspDepthSceneInfoSDFG {
+  XrStructureType type;  // XR_TYPE_GRASP_DEPTH_SCENE_INFO_SDFG
+  void* XR_MAY_ALIAS next;
+  XrBool32 enabled;     // this session reads the depth the app submits
+  uint32_t framesRead;  // frames of the app's depth handed to the scene so far
+  XrBool32 ready;       // the depth around this hand holds a fused frame: fingers stop on it
+} XrGraspDepthSceneInfoSDFG;
+
+// The depth scene (docs/depth.md, config depth_scene = on): what XrGraspStateSDFG::target,
+// XrGraspTouchesSDFG::touched[] and XrEventDataGraspChangedSDFG::target hold for what the layer
+// knows only from the depth the app submits (XR_KHR_composition_layer_depth). Not a handle: no
+// function takes it, and it never equals one the layer hands out.
+#define XR_GRASP_TARGET_DEPTH_SCENE_SDFG ((XrGraspTargetSDFG)(uint64_t)0x4000000000000000ull)
+
 #ifdef __cplusplus
 }
 #endif

@@ -161,15 +161,8 @@ bool DepthSubmitter::createVulkanObjects() {
   if (vkCreateBuffer(device, &bi, nullptr, &staging_) != VK_SUCCESS) return fail("vkCreateBuffer");
   VkMemoryRequirements req{};
   vkGetBufferMemoryRequirements(device, staging_, &req);
-  VkPhysicalDeviceMemoryProperties mem{};
-  vkGetPhysicalDeviceMemoryProperties(app_.vk.physicalDevice, &mem);
-  const VkMemoryPropertyFlags want =
-      VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-  uint32_t type = 0;
-  while (type < mem.memoryTypeCount && (!(req.memoryTypeBits & (1u << type)) ||
-                                        (mem.memoryTypes[type].propertyFlags & want) != want))
-    ++type;
-  if (type == mem.memoryTypeCount) return fail("no host-visible coherent memory");
+  const uint32_t type = hostCoherentMemoryType(app_.vk, req.memoryTypeBits);
+  if (type == UINT32_MAX) return fail("no host-visible coherent memory");
   VkMemoryAllocateInfo mi{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   mi.allocationSize = req.size;
   mi.memoryTypeIndex = type;

@@ -70,6 +70,8 @@ const KeyCase kKeys[] = {
      "200"},
     {"offset_blend_time", "0.5", [](const Config& c) { return c.offsetBlendTime == 0.5f; }, "3"},
     {"build_time_limit_ms", "250", [](const Config& c) { return c.buildTimeLimitMs == 250u; }, "0"},
+    {"depth_scene", "off", [](const Config& c) { return c.depthScene == Config::DepthScene::off; },
+     "sometimes"},
 };
 
 }  // namespace

@@ -163,6 +163,17 @@ std::string vulkanUnavailable() {
   return devices == 0 ? "no Vulkan physical device" : "";
 }
 
+uint32_t hostCoherentMemoryType(const VulkanSide& vk, uint32_t typeBits) {
+  VkPhysicalDeviceMemoryProperties mem;
+  vkGetPhysicalDeviceMemoryProperties(vk.physicalDevice, &mem);
+  const VkMemoryPropertyFlags want =
+      VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  for (uint32_t type = 0; type < mem.memoryTypeCount; ++type)
+    if ((typeBits & (1u << type)) && (mem.memoryTypes[type].propertyFlags & want) == want)
+      return type;
+  return UINT32_MAX;
+}
+
 HostBuffer App::createBuffer(VkDeviceSize bytes) {
   HostBuffer b;
   VkBufferCreateInfo bi{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
@@ -172,19 +183,11 @@ HostBuffer App::createBuffer(VkDeviceSize bytes) {
   if (vkCreateBuffer(vk.device, &bi, nullptr, &b.buffer) != VK_SUCCESS) return {};
   VkMemoryRequirements req;
   vkGetBufferMemoryRequirements(vk.device, b.buffer, &req);
-  VkPhysicalDeviceMemoryProperties mem;
-  vkGetPhysicalDeviceMemoryProperties(vk.physicalDevice, &mem);
-  const VkMemoryPropertyFlags want =
-      VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-  uint32_t type = 0;
-  while (type < mem.memoryTypeCount && (!(req.memoryTypeBits & (1u << type)) ||
-                                        (mem.memoryTypes[type].propertyFlags & want) != want))
-    ++type;
+  const uint32_t type = hostCoherentMemoryType(vk, req.memoryTypeBits);
   VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   ai.allocationSize = req.size;
   ai.memoryTypeIndex = type;
-  if (type == mem.memoryTypeCount ||
-      vkAllocateMemory(vk.device, &ai, nullptr, &b.memory) != VK_SUCCESS ||
+  if (type == UINT32_MAX || vkAllocateMemory(vk.device, &ai, nullptr, &b.memory) != VK_SUCCESS ||
       vkBindBufferMemory(vk.device, b.buffer, b.memory, 0) != VK_SUCCESS ||
       vkMapMemory(vk.device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped) != VK_SUCCESS) {
     if (b.memory != VK_NULL_HANDLE) vkFreeMemory(vk.device, b.memory, nullptr);

@@ -71,6 +71,9 @@ struct HostBuffer {
   void* mapped = nullptr;
 };
 
+// A host-visible, coherent memory type among `typeBits` of the app's device; UINT32_MAX if none.
+uint32_t hostCoherentMemoryType(const VulkanSide& vk, uint32_t typeBits);
+
 // Warning and error messages of the Vulkan validation layer so far (all apps of the process).
 std::vector<std::string> vulkanMessages();
 // Why a Vulkan app cannot run here (no loader, no device, no validation layer); empty if it can.

@@ -74,6 +74,7 @@ struct VkFunctions {
   X(vkCmdDispatch)                  \
   X(vkCmdPipelineBarrier)           \
   X(vkCmdCopyBuffer)                \
+  X(vkCmdCopyImageToBuffer)         \
   X(vkCmdFillBuffer)                \
   X(vkCreateFence)                  \
   X(vkDestroyFence)                 \

@@ -58,6 +58,9 @@ struct Config {
   float offsetBlendTime = 0.1f;
   // The outer hand (docs/layer.md, "The outer hand"): outer_hand, outer_release_distance
   // (metres), outer_blend_time (seconds).
+  bool outerHand = true;
+  float outerReleaseDistance = 0.10f;
+  float outerBlendTime = 0.25f;
   // depth_scene (docs/depth.md): the scene from the depth a Vulkan app submits with
   // XR_KHR_composition_layer_depth. auto: for apps that do not use XR_SDFG_auto_grasp (an app
   // that registers its targets has its scene); on: for every app that submits depth, its
@@ -65,9 +68,6 @@ struct Config {
   // as the app asks).
   enum class DepthScene { automatic, on, off };
   DepthScene depthScene = DepthScene::automatic;
-  bool outerHand = true;
-  float outerReleaseDistance = 0.10f;
-  float outerBlendTime = 0.25f;
 };
 
 Config loadConfig();

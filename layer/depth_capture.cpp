@@ -22,18 +22,14 @@ constexpr uint32_t kMaxReadSide = 320;
 // How long teardown (xrDestroySwapchain, the session's end) waits for a copy in flight.
 constexpr uint64_t kTeardownWaitNs = 2'000'000'000ull;
 
-bool isDepthFormat(int64_t f) {
-  switch (VkFormat(f)) {
-    case VK_FORMAT_D16_UNORM:
-    case VK_FORMAT_X8_D24_UNORM_PACK32:
-    case VK_FORMAT_D32_SFLOAT:
-    case VK_FORMAT_D16_UNORM_S8_UINT:
-    case VK_FORMAT_D24_UNORM_S8_UINT:
-    case VK_FORMAT_D32_SFLOAT_S8_UINT:
-      return true;
-    default:
-      return false;
-  }
+// A depth format the copy can read (vulkan/vk_depth_capture.h); none without the Vulkan path.
+bool readableDepthFormat(int64_t f) {
+#if SDFG_LAYER_VULKAN
+  return VkDepthCapture::readableFormat(VkFormat(f));
+#else
+  (void)f;
+  return false;
+#endif
 }
 
 // The device copy object, held by one thread at a time; never waited for in a frame call.
@@ -113,7 +109,7 @@ void logOnce(bool SessionDepth::*flag, SessionDepth& d, const char* cmd, const c
 
 bool depthSceneWanted(const SessionState& s) {
   const InstanceState& inst = *s.instance;
-  if (!s.vulkan || !inst.appDepthLayer) return false;
+  if (!SDFG_LAYER_VULKAN || !s.vulkan || !inst.appDepthLayer) return false;
   switch (inst.config.depthScene) {
     case Config::DepthScene::off:
       return false;
@@ -135,13 +131,13 @@ XrResult XRAPI_CALL SdfgXrCreateSwapchain(XrSession session, const XrSwapchainCr
   // Anything the runtime must judge (a null or mistyped info) goes down as it is.
   if (info == nullptr || swapchain == nullptr || info->type != XR_TYPE_SWAPCHAIN_CREATE_INFO)
     return next(session, info, swapchain);
-  const bool depthChain = s->depth != nullptr && isDepthFormat(info->format) &&
+  const bool depthChain = s->depth != nullptr && readableDepthFormat(info->format) &&
                           (info->usageFlags & XR_SWAPCHAIN_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
-  bool readable = depthChain && info->sampleCount == 1 && info->faceCount == 1 &&
-                  (info->usageFlags & XR_SWAPCHAIN_USAGE_TRANSFER_SRC_BIT);
+  const bool copyable = depthChain && info->sampleCount == 1 && info->faceCount == 1;
+  bool readable = copyable && (info->usageFlags & XR_SWAPCHAIN_USAGE_TRANSFER_SRC_BIT);
   XrResult r = XR_ERROR_RUNTIME_FAILURE;
   bool made = false;
-  if (depthChain && info->sampleCount == 1 && info->faceCount == 1 && !readable) {
+  if (copyable && !readable) {
     XrSwapchainCreateInfo withCopy = *info;
     withCopy.usageFlags |= XR_SWAPCHAIN_USAGE_TRANSFER_SRC_BIT;
     r = next(session, &withCopy, swapchain);
@@ -400,10 +396,10 @@ void captureDepthAtEndFrame(SessionState& s, const XrFrameEndInfo* info) {
           const Pose localFromSpace = toPose(loc.pose);
           for (DepthView& view : frame.views)
             view.worldFromView = localFromSpace * view.worldFromView;
-          std::vector<uint64_t> taken;
+          // The frame holds the copies now (a swapchain the views share is taken once).
           for (const auto& sc : used) {
             std::lock_guard lock(sc->mutex);
-            if (sc->lastCopy != 0) taken.push_back(std::exchange(sc->lastCopy, 0));
+            sc->lastCopy = 0;
           }
           std::lock_guard lock(d.mutex);
           d.frames.push_back(std::move(frame));

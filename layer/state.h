@@ -364,11 +364,10 @@ void updateInputAtFrame(SessionState& session);
 // layer is built without it, the config says gpu = false, or the device cannot be used; the
 // reason is logged): the engine's side of its mailbox. Sets session.gpu and session.ownQueue.
 std::unique_ptr<DeferredSdfBackend> makeVulkanBackend(SessionState& session);
-// vulkan.cpp: the app's Vulkan loader entry point for `vkInstance` (enable2: what the app passed
-// for it; enable: the loader in the process); null when there is none.
-PFN_vkGetInstanceProcAddr appVulkanGetInstanceProcAddr(InstanceState& inst, VkInstance vkInstance);
 #if SDFG_LAYER_VULKAN
-// The session's Vulkan binding as the engine borrows it, with the app's loader entry point.
+// vulkan.cpp: the session's Vulkan binding as the engine borrows it, with the app's loader entry
+// point (enable2: what the app passed for its instance; enable: the loader in the process; null
+// when there is none).
 VulkanDevice appVulkanDevice(SessionState& session);
 #endif
 // Does the session's GPU calls (DeferredMailbox::pump): `inFrame` inside xrBeginFrame /

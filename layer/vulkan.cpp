@@ -33,6 +33,17 @@ std::shared_ptr<InstanceState> instanceOf(XrInstance handle) {
 }
 
 #if SDFG_LAYER_VULKAN
+// The app's Vulkan loader entry point for `vkInstance`.
+PFN_vkGetInstanceProcAddr appGetInstanceProcAddr(InstanceState& inst, VkInstance vkInstance) {
+  {
+    std::lock_guard lock(inst.vulkanMutex);
+    auto it = inst.vulkanGipa.find(key(vkInstance));
+    if (it != inst.vulkanGipa.end()) return it->second;
+  }
+  // Enable (v1): the loader the app linked (or loaded) is in the process already.
+  return reinterpret_cast<PFN_vkGetInstanceProcAddr>(platform::loadedVulkanGetInstanceProcAddr());
+}
+
 VkGraspFault faultFromConfig(const std::string& name) {
   if (name == "lost_at_submit") return VkGraspFault::lostAtSubmit;
   if (name == "lost_at_poll") return VkGraspFault::lostAtPoll;
@@ -44,16 +55,6 @@ VkGraspFault faultFromConfig(const std::string& name) {
 
 }  // namespace
 
-PFN_vkGetInstanceProcAddr appVulkanGetInstanceProcAddr(InstanceState& inst, VkInstance vkInstance) {
-  {
-    std::lock_guard lock(inst.vulkanMutex);
-    auto it = inst.vulkanGipa.find(key(vkInstance));
-    if (it != inst.vulkanGipa.end()) return it->second;
-  }
-  // Enable (v1): the loader the app linked (or loaded) is in the process already.
-  return reinterpret_cast<PFN_vkGetInstanceProcAddr>(platform::loadedVulkanGetInstanceProcAddr());
-}
-
 #if SDFG_LAYER_VULKAN
 VulkanDevice appVulkanDevice(SessionState& s) {
   const XrGraphicsBindingVulkanKHR& b = s.vulkanBinding;
@@ -63,7 +64,7 @@ VulkanDevice appVulkanDevice(SessionState& s) {
   app.device = b.device;
   app.queueFamilyIndex = b.queueFamilyIndex;
   app.queueIndex = b.queueIndex;
-  app.getInstanceProcAddr = appVulkanGetInstanceProcAddr(*s.instance, b.instance);
+  app.getInstanceProcAddr = appGetInstanceProcAddr(*s.instance, b.instance);
   return app;
 }
 #endif

@@ -57,6 +57,42 @@ struct Drawn {
   }
 };
 
+// The app's tracker of its right hand (synthesized from the controller: hand tracking absent).
+XrHandTrackerEXT rightTracker(const App& app) {
+  auto create = app.fn<PFN_xrCreateHandTrackerEXT>("xrCreateHandTrackerEXT");
+  REQUIRE(create != nullptr);
+  XrHandTrackerCreateInfoEXT ci{XR_TYPE_HAND_TRACKER_CREATE_INFO_EXT};
+  ci.hand = XR_HAND_RIGHT_EXT;
+  ci.handJointSet = XR_HAND_JOINT_SET_DEFAULT_EXT;
+  XrHandTrackerEXT tracker = XR_NULL_HANDLE;
+  REQUIRE(create(app.session, &ci, &tracker) == XR_SUCCESS);
+  return tracker;
+}
+
+// The right hand's grasp state with `out` chained on it (apps that enabled the extension).
+template <class Out>
+Out rightHandOutput(const App& app, Out out) {
+  auto getState = app.fn<PFN_xrGetGraspStateSDFG>("xrGetGraspStateSDFG");
+  REQUIRE(getState != nullptr);
+  XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG, &out};
+  XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
+  REQUIRE(getState(app.session, &gi, &st) == XR_SUCCESS);
+  return out;
+}
+
+// Whether the layer reads the app's depth and it is fused around the right hand.
+bool depthReady(const App& app) {
+  const auto info =
+      rightHandOutput(app, XrGraspDepthSceneInfoSDFG{XR_TYPE_GRASP_DEPTH_SCENE_INFO_SDFG});
+  CHECK(info.enabled == XR_TRUE);
+  return info.ready == XR_TRUE;
+}
+
+// What the right hand's fingers touch, and whether it rests on a solve (isClosed).
+XrGraspTouchesSDFG rightTouches(const App& app) {
+  return rightHandOutput(app, XrGraspTouchesSDFG{XR_TYPE_GRASP_TOUCHES_SDFG});
+}
+
 struct Run {
   Joints closed;                    // the hand once it stopped moving with the squeeze held
   uint64_t depthFrames;             // frames the app submitted depth in
@@ -123,23 +159,8 @@ Run runApp(const AppCase& c) {
   ao.graphics = Graphics::vulkan2;
   App app(ao);
   REQUIRE(app.ok());
-  auto createTracker = app.fn<PFN_xrCreateHandTrackerEXT>("xrCreateHandTrackerEXT");
-  REQUIRE(createTracker != nullptr);
-  auto getState = app.fn<PFN_xrGetGraspStateSDFG>("xrGetGraspStateSDFG");
-  REQUIRE((getState != nullptr) == c.observe);
-  const auto depthReady = [&] {
-    XrGraspDepthSceneInfoSDFG info{XR_TYPE_GRASP_DEPTH_SCENE_INFO_SDFG};
-    XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG, &info};
-    XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
-    REQUIRE(getState(app.session, &gi, &st) == XR_SUCCESS);
-    CHECK(info.enabled == XR_TRUE);
-    return info.ready == XR_TRUE;
-  };
-  XrHandTrackerCreateInfoEXT ci{XR_TYPE_HAND_TRACKER_CREATE_INFO_EXT};
-  ci.hand = XR_HAND_RIGHT_EXT;
-  ci.handJointSet = XR_HAND_JOINT_SET_DEFAULT_EXT;
-  XrHandTrackerEXT tracker = XR_NULL_HANDLE;
-  REQUIRE(createTracker(app.session, &ci, &tracker) == XR_SUCCESS);
+  REQUIRE((app.fn<PFN_xrGetGraspStateSDFG>("xrGetGraspStateSDFG") != nullptr) == c.observe);
+  const XrHandTrackerEXT tracker = rightTracker(app);
 
   const Drawn drawn;
   std::optional<DepthSubmitter> depth;
@@ -164,19 +185,11 @@ Run runApp(const AppCase& c) {
   };
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
   // Before the squeeze: the scene is ready (observed apps), or 30 frames of depth went down.
-  while (depth && (c.observe && c.expectDepth ? !depthReady() : depth->submitted() < 30)) {
+  while (depth && (c.observe && c.expectDepth ? !depthReady(app) : depth->submitted() < 30)) {
     REQUIRE(std::chrono::steady_clock::now() < deadline);
     frame();
     REQUIRE(locateJoints(app, tracker, last) == XR_SUCCESS);
   }
-  // A grab the layer has answered (observed apps: its fingers rest on a solve).
-  const auto closedOnSolve = [&] {
-    XrGraspTouchesSDFG touches{XR_TYPE_GRASP_TOUCHES_SDFG};
-    XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG, &touches};
-    XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
-    REQUIRE(getState(app.session, &gi, &st) == XR_SUCCESS);
-    return touches.isClosed == XR_TRUE;
-  };
   // Runs frames until the hand has not moved for 20 of them and 1.5 s: the frames before the
   // worker's answer show the hand closing by the squeeze alone, as many as the worker is late.
   const auto untilStill = [&](bool answered) {
@@ -184,7 +197,7 @@ Run runApp(const AppCase& c) {
     auto since = std::chrono::steady_clock::now();
     while (still < 20 ||
            std::chrono::steady_clock::now() - since < std::chrono::milliseconds(1500) ||
-           (answered && !closedOnSolve())) {
+           (answered && rightTouches(app).isClosed != XR_TRUE)) {
       REQUIRE(std::chrono::steady_clock::now() < deadline);
       frame();
       Joints now;
@@ -221,11 +234,7 @@ Run runApp(const AppCase& c) {
     untilStill(false);
   }
   if (c.observe) {
-    XrGraspTouchesSDFG touches{XR_TYPE_GRASP_TOUCHES_SDFG};
-    XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG, &touches};
-    XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
-    REQUIRE(getState(app.session, &gi, &st) == XR_SUCCESS);
-    for (XrGraspTargetSDFG t : touches.touched)
+    for (XrGraspTargetSDFG t : rightTouches(app).touched)
       run.onDepthScene += t == XR_GRASP_TARGET_DEPTH_SCENE_SDFG ? 1 : 0;
   }
   run.closed = last;
@@ -419,12 +428,7 @@ TEST_CASE("An open hand lowered into a table the app only draws is shown on it",
   ao.graphics = Graphics::vulkan2;
   App app(ao);
   REQUIRE(app.ok());
-  auto createTracker = app.fn<PFN_xrCreateHandTrackerEXT>("xrCreateHandTrackerEXT");
-  XrHandTrackerCreateInfoEXT ci{XR_TYPE_HAND_TRACKER_CREATE_INFO_EXT};
-  ci.hand = XR_HAND_RIGHT_EXT;
-  ci.handJointSet = XR_HAND_JOINT_SET_DEFAULT_EXT;
-  XrHandTrackerEXT tracker = XR_NULL_HANDLE;
-  REQUIRE(createTracker(app.session, &ci, &tracker) == XR_SUCCESS);
+  const XrHandTrackerEXT tracker = rightTracker(app);
   // The open hand as tracked, before anything is near it: the table's top goes 1 cm below it.
   Joints open;
   for (int k = 0; k < 10 || !open.locations.isActive; ++k) {
@@ -456,16 +460,9 @@ TEST_CASE("An open hand lowered into a table the app only draws is shown on it",
     std::this_thread::sleep_for(kFramePeriod);
   };
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  auto getState = app.fn<PFN_xrGetGraspStateSDFG>("xrGetGraspStateSDFG");
-  REQUIRE(getState != nullptr);
-  for (;;) {
+  while (!depthReady(app)) {
     REQUIRE(std::chrono::steady_clock::now() < deadline);
     frame();
-    XrGraspDepthSceneInfoSDFG info{XR_TYPE_GRASP_DEPTH_SCENE_INFO_SDFG};
-    XrGraspStateSDFG st{XR_TYPE_GRASP_STATE_SDFG, &info};
-    XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
-    REQUIRE(getState(app.session, &gi, &st) == XR_SUCCESS);
-    if (info.ready) break;
   }
   // Down 1 mm a frame, 40 frames: the tracked hand ends 3 cm into the table.
   const uint64_t first = app.framesEnded + 1;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <thread>
 
 #include "intercepts.h"
@@ -19,6 +20,13 @@ constexpr size_t kMaxFramesWaiting = 3;
 // The longest side the layer reads of a view's depth; a larger rect is read every k-th pixel
 // (the fusion's voxels are millimetres: at 40 cm a 90-degree view of 320 pixels is 2.5 mm each).
 constexpr uint32_t kMaxReadSide = 320;
+// Metres added to each side of a hand's fusion box before it places a copy: the box is the one of
+// the last xrEndFrame, and the hand moves a frame or two before the copy's frame is fused (2 m/s
+// is 2.2 cm a frame at 90 Hz).
+constexpr float kBoxMargin = 0.05f;
+// The copy's rect grows by this fraction of the view's longer side, for the head's turn since the
+// view it was placed in (100 degrees a second is 1.1 degrees a frame: 2 % of a 90-degree view).
+constexpr float kTurnMargin = 0.04f;
 // How long teardown (xrDestroySwapchain, the session's end) waits for a copy in flight.
 constexpr uint64_t kTeardownWaitNs = 2'000'000'000ull;
 
@@ -92,6 +100,56 @@ void discardOrphans(SessionDepth& d) {
   }
   if (d.gpu)
     for (uint64_t t : orphans) d.gpu->discard(t);
+}
+
+// The rects of `sc`'s layers worth copying (the caller holds sc.mutex): in each layer, the pixels
+// whose rays meet one of `boxes` in the view last submitted from it, grown for the head's turn;
+// the whole layer before any view. Empty when no box is known or none is in sight.
+std::vector<VkDepthRect> regionsToCopy(const SwapchainState& sc,
+                                       const std::vector<std::pair<glm::vec3, glm::vec3>>& boxes) {
+  std::vector<VkDepthRect> out;
+  if (boxes.empty()) return out;
+  for (uint32_t layer = 0; layer < sc.layers; ++layer) {
+    if (layer >= sc.seen.size() || !sc.seen[layer]) {
+      out.push_back(VkDepthRect{layer, 0, 0, sc.width, sc.height});
+      continue;
+    }
+    const SwapchainState::SeenView& seen = *sc.seen[layer];
+    int64_t x0 = INT64_MAX, y0 = INT64_MAX, x1 = INT64_MIN, y1 = INT64_MIN;
+    for (const auto& [lo, hi] : boxes) {
+      const auto r = seen.view.cover(lo, hi);
+      if (!r) continue;
+      x0 = std::min<int64_t>(x0, int64_t(seen.x) + r->x);
+      y0 = std::min<int64_t>(y0, int64_t(seen.y) + r->y);
+      x1 = std::max<int64_t>(x1, int64_t(seen.x) + r->x + r->width);
+      y1 = std::max<int64_t>(y1, int64_t(seen.y) + r->y + r->height);
+    }
+    if (x0 >= x1 || y0 >= y1) continue;  // no hand in sight of this layer
+    const int64_t grow =
+        2 + int64_t(kTurnMargin * float(std::max(seen.view.width, seen.view.height)));
+    x0 = std::max<int64_t>(x0 - grow, 0);
+    y0 = std::max<int64_t>(y0 - grow, 0);
+    x1 = std::min<int64_t>(x1 + grow, sc.width);
+    y1 = std::min<int64_t>(y1 + grow, sc.height);
+    if (x0 >= x1 || y0 >= y1) continue;
+    out.push_back(
+        VkDepthRect{layer, int32_t(x0), int32_t(y0), uint32_t(x1 - x0), uint32_t(y1 - y0)});
+  }
+  return out;
+}
+
+// The part of `rect` (of `layer`) that `regions` hold; empty when none does.
+VkDepthRect heldPart(const std::vector<VkDepthRect>& regions, uint32_t layer,
+                     const VkDepthRect& rect) {
+  for (const VkDepthRect& r : regions) {
+    if (r.layer != layer) continue;
+    const int64_t x0 = std::max<int64_t>(r.x, rect.x), y0 = std::max<int64_t>(r.y, rect.y);
+    const int64_t x1 = std::min<int64_t>(int64_t(r.x) + r.width, int64_t(rect.x) + rect.width);
+    const int64_t y1 = std::min<int64_t>(int64_t(r.y) + r.height, int64_t(rect.y) + rect.height);
+    if (x0 < x1 && y0 < y1)
+      return VkDepthRect{layer, int32_t(x0), int32_t(y0), uint32_t(x1 - x0), uint32_t(y1 - y0)};
+  }
+  return VkDepthRect{layer, 0, 0, 0, 0};
 }
 #endif
 
@@ -254,30 +312,39 @@ XrResult XRAPI_CALL SdfgXrReleaseSwapchainImage(XrSwapchain swapchain,
     return logError(XR_ERROR_HANDLE_INVALID, cmd, "(swapchain) is not valid");
   uint64_t copy = 0;
 #if SDFG_LAYER_VULKAN
+  std::vector<VkDepthRect> regions;
   if (sc->depth && s->depth != nullptr) {
-    VkDepthImage image;
-    {
-      std::lock_guard lock(sc->mutex);
-      // The release gives back the oldest image acquired (and waited for, or the runtime refuses).
-      if (!sc->acquired.empty() && sc->acquired.front() < sc->images.size())
-        image.image = sc->images[sc->acquired.front()];
-    }
-    image.format = VkFormat(sc->format);
-    image.width = sc->width;
-    image.height = sc->height;
-    image.layers = sc->layers;
     SessionDepth& d = *s->depth;
-    Claim claim(d);
-    if (image.image != VK_NULL_HANDLE && claim.held()) {
-      try {
+    try {
+      VkDepthImage image;
+      std::vector<std::pair<glm::vec3, glm::vec3>> boxes;
+      {
+        std::lock_guard lock(d.mutex);
+        boxes = d.boxes;
+      }
+      {
+        std::lock_guard lock(sc->mutex);
+        // The release gives back the oldest image acquired (and waited for, or the runtime
+        // refuses).
+        if (!sc->acquired.empty() && sc->acquired.front() < sc->images.size())
+          image.image = sc->images[sc->acquired.front()];
+        regions = regionsToCopy(*sc, boxes);
+      }
+      image.format = VkFormat(sc->format);
+      image.width = sc->width;
+      image.height = sc->height;
+      image.layers = sc->layers;
+      Claim claim(d);
+      if (image.image != VK_NULL_HANDLE && !regions.empty() && claim.held()) {
         discardOrphans(d);
         if (VkDepthCapture* gpu = deviceCapture(*s, d)) {
-          auto made = gpu->submit(image);
+          auto made = gpu->submit(image, regions);
           if (made) copy = made.value();
         }
-      } catch (...) {
-        // Out of memory in the layer: this frame goes without depth.
       }
+    } catch (...) {
+      // Out of memory in the layer: this frame goes without depth.
+      copy = 0;
     }
   }
 #endif
@@ -287,7 +354,11 @@ XrResult XRAPI_CALL SdfgXrReleaseSwapchainImage(XrSwapchain swapchain,
     {
       std::lock_guard lock(sc->mutex);
       if (XR_SUCCEEDED(r) && !sc->acquired.empty()) sc->acquired.pop_front();
-      if (copy != 0) replaced = std::exchange(sc->lastCopy, copy);
+      // Even without a copy: the frame must not read an older image's with this one's view.
+      replaced = std::exchange(sc->lastCopy, copy);
+#if SDFG_LAYER_VULKAN
+      sc->lastRegions = copy != 0 ? std::move(regions) : std::vector<VkDepthRect>{};
+#endif
     }
     if (replaced != 0 && s->depth != nullptr) {
       std::lock_guard lock(s->depth->mutex);
@@ -320,15 +391,33 @@ void captureDepthAtEndFrame(SessionState& s, const XrFrameEndInfo* info) {
       }
     }
     XrSpace local = XR_NULL_HANDLE;
+    std::vector<std::pair<glm::vec3, glm::vec3>> boxes;
     {
       std::lock_guard lock(s.mutex);
       local = s.localSpace;
+      if (s.grasp != nullptr)
+        for (const auto& box : s.grasp->depthBoxes())
+          if (box)
+            boxes.emplace_back(box->lo - glm::vec3(kBoxMargin), box->hi + glm::vec3(kBoxMargin));
+    }
+    {
+      std::lock_guard lock(d.mutex);
+      d.boxes = std::move(boxes);
     }
     if (projection != nullptr && local != XR_NULL_HANDLE) {
-      DepthFrame frame;
-      frame.time = double(info->displayTime) * 1e-9;
+      // Each view: its swapchain, its whole rect as a DepthView (in the layer's space until
+      // located below), and the part of the rect its copy holds (none: out of the hands' sight,
+      // or every slot was busy).
+      struct Entry {
+        std::shared_ptr<SwapchainState> sc;
+        uint32_t layer = 0;
+        XrOffset2Di offset{};
+        DepthView view;
+        uint64_t copy = 0;
+        VkDepthRect held;
+      };
+      std::vector<Entry> entries;
       bool bad = false, unknown = false;
-      std::vector<std::shared_ptr<SwapchainState>> used;
       for (uint32_t v = 0; v < projection->viewCount && !bad && !unknown; ++v) {
         const XrCompositionLayerProjectionView& pv = projection->views[v];
         const auto* di = findInChain<const XrCompositionLayerDepthInfoKHR>(
@@ -346,34 +435,31 @@ void captureDepthAtEndFrame(SessionState& s, const XrFrameEndInfo* info) {
           bad = true;
           break;
         }
-        uint64_t copy = 0;
-        {
-          std::lock_guard lock(sc->mutex);
-          copy = sc->lastCopy;
-        }
-        if (copy == 0) break;  // no copy of this image (every slot was busy): no depth this frame
-        const uint32_t side = uint32_t(std::max(rect.extent.width, rect.extent.height));
-        const uint32_t step = (side + kMaxReadSide - 1) / kMaxReadSide;
-        DepthView view;
-        view.worldFromView = toPose(pv.pose);  // in the layer's space until located below
-        view.fov = {pv.fov.angleLeft, pv.fov.angleRight, pv.fov.angleUp, pv.fov.angleDown};
-        view.width = (uint32_t(rect.extent.width) + step - 1) / step;
-        view.height = (uint32_t(rect.extent.height) + step - 1) / step;
-        view.minDepth = di->minDepth;
-        view.maxDepth = di->maxDepth;
-        view.nearZ = di->nearZ;
-        view.farZ = di->farZ;
-        if (view.validate()) {
+        Entry e;
+        e.layer = di->subImage.imageArrayIndex;
+        e.offset = rect.offset;
+        e.view.worldFromView = toPose(pv.pose);
+        e.view.fov = {pv.fov.angleLeft, pv.fov.angleRight, pv.fov.angleUp, pv.fov.angleDown};
+        e.view.width = uint32_t(rect.extent.width);
+        e.view.height = uint32_t(rect.extent.height);
+        e.view.minDepth = di->minDepth;
+        e.view.maxDepth = di->maxDepth;
+        e.view.nearZ = di->nearZ;
+        e.view.farZ = di->farZ;
+        if (e.view.validate()) {
           bad = true;
           break;
         }
-        frame.views.push_back(view);
-        frame.copies.push_back(copy);
-        frame.rects.push_back(VkDepthRect{di->subImage.imageArrayIndex, rect.offset.x,
-                                          rect.offset.y, uint32_t(rect.extent.width),
-                                          uint32_t(rect.extent.height)});
-        frame.steps.push_back(step);
-        used.push_back(sc);
+        {
+          std::lock_guard lock(sc->mutex);
+          e.copy = sc->lastCopy;
+          if (e.copy != 0)
+            e.held = heldPart(
+                sc->lastRegions, e.layer,
+                VkDepthRect{e.layer, rect.offset.x, rect.offset.y, e.view.width, e.view.height});
+        }
+        e.sc = std::move(sc);
+        entries.push_back(std::move(e));
       }
       if (bad)
         logOnce(&SessionDepth::badInfoLogged, d, cmd,
@@ -386,22 +472,50 @@ void captureDepthAtEndFrame(SessionState& s, const XrFrameEndInfo* info) {
                 "this session, or one whose transfer-source usage was refused): no depth scene "
                 "from it");
       // 2. Where the views are: the layer's space in the layer's LOCAL at the display time.
-      if (!bad && !unknown && frame.views.size() == projection->viewCount) {
-        XrSpaceLocation loc{XR_TYPE_SPACE_LOCATION};
-        const XrResult r =
-            s.instance->next.xrLocateSpace(projection->space, local, info->displayTime, &loc);
-        const XrSpaceLocationFlags need =
-            XR_SPACE_LOCATION_POSITION_VALID_BIT | XR_SPACE_LOCATION_ORIENTATION_VALID_BIT;
-        if (XR_SUCCEEDED(r) && (loc.locationFlags & need) == need && isFinitePose(loc.pose)) {
-          const Pose localFromSpace = toPose(loc.pose);
-          for (DepthView& view : frame.views)
-            view.worldFromView = localFromSpace * view.worldFromView;
-          // The frame holds the copies now (a swapchain the views share is taken once).
-          for (const auto& sc : used) {
-            std::lock_guard lock(sc->mutex);
-            sc->lastCopy = 0;
+      XrSpaceLocation loc{XR_TYPE_SPACE_LOCATION};
+      const XrSpaceLocationFlags need =
+          XR_SPACE_LOCATION_POSITION_VALID_BIT | XR_SPACE_LOCATION_ORIENTATION_VALID_BIT;
+      if (!bad && !unknown && entries.size() == projection->viewCount &&
+          XR_SUCCEEDED(
+              s.instance->next.xrLocateSpace(projection->space, local, info->displayTime, &loc)) &&
+          (loc.locationFlags & need) == need && isFinitePose(loc.pose)) {
+        const Pose localFromSpace = toPose(loc.pose);
+        DepthFrame frame;
+        frame.time = double(info->displayTime) * 1e-9;
+        for (Entry& e : entries) {
+          e.view.worldFromView = localFromSpace * e.view.worldFromView;
+          {
+            // The view places the next copy of its layer; the frame holds this one now (a
+            // swapchain the views share is taken once).
+            std::lock_guard lock(e.sc->mutex);
+            if (e.sc->seen.size() < e.sc->layers) e.sc->seen.resize(e.sc->layers);
+            e.sc->seen[e.layer] = SwapchainState::SeenView{e.view, e.offset.x, e.offset.y};
+            e.sc->lastCopy = 0;
+            e.sc->lastRegions.clear();
           }
-          std::lock_guard lock(d.mutex);
+          if (e.copy == 0 || e.held.width == 0) continue;
+          // The held part of the rect, read every step-th pixel so that its longer side is
+          // kMaxReadSide at most.
+          const uint32_t side = std::max(e.held.width, e.held.height);
+          const uint32_t step = (side + kMaxReadSide - 1) / kMaxReadSide;
+          DepthView view = e.view.crop(DepthPixelRect{uint32_t(e.held.x - e.offset.x),
+                                                      uint32_t(e.held.y - e.offset.y), e.held.width,
+                                                      e.held.height});
+          view.width = (e.held.width + step - 1) / step;
+          view.height = (e.held.height + step - 1) / step;
+          frame.views.push_back(view);
+          frame.copies.push_back(e.copy);
+          frame.rects.push_back(e.held);
+          frame.steps.push_back(step);
+        }
+        std::lock_guard lock(d.mutex);
+        // A copy no view reads (its part of the rects out of the hands' sight) is done with.
+        for (const Entry& e : entries)
+          if (e.copy != 0 &&
+              std::find(frame.copies.begin(), frame.copies.end(), e.copy) == frame.copies.end() &&
+              std::find(d.orphans.begin(), d.orphans.end(), e.copy) == d.orphans.end())
+            d.orphans.push_back(e.copy);
+        if (!frame.views.empty()) {
           d.frames.push_back(std::move(frame));
           while (d.frames.size() > kMaxFramesWaiting) {
             for (uint64_t t : d.frames.front().copies) d.orphans.push_back(t);

@@ -7,8 +7,11 @@
 //   exactly as the app asked and the log says once that its depth is not read.
 // - xrEnumerateSwapchainImages / xrAcquireSwapchainImage: the images and which one is acquired.
 // - xrReleaseSwapchainImage: before the call goes down (the image is still the app's, in the
-//   depth-attachment layout, and the queue is the runtime's to use during the call), one copy of
-//   the whole image on the app's queue (vulkan/vk_depth_capture.h); nothing waits for it.
+//   depth-attachment layout, and the queue is the runtime's to use during the call), one copy on
+//   the app's queue (vulkan/vk_depth_capture.h) of the pixels that can see a hand's fusion box, as
+//   the view last submitted from each layer saw them (grown for the motion of a frame), or of the
+//   whole layer before any view; nothing when no hand is known or none is in sight. Nothing
+//   waits for it.
 // - xrEndFrame: each projection view's depth info names a released image; with the view's pose
 //   (its layer's space located in the layer's LOCAL space at the display time), field of view,
 //   rect and depth range it becomes a DepthView. Copies a frame or more old that have finished are
@@ -25,7 +28,11 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <utility>
 #include <vector>
+
+#include <glm/vec3.hpp>
 
 #include "depth/depth_view.h"
 #include "xr_includes.h"
@@ -49,7 +56,17 @@ struct SwapchainState {
   std::mutex mutex;  // guards the fields below; never held across a call
   std::vector<VkImage> images;
   std::deque<uint32_t> acquired;  // acquired and not released, oldest first
-  uint64_t lastCopy = 0;          // ticket of the copy of the image released last, not yet framed
+  uint64_t lastCopy = 0;  // ticket of the copy of the image released last, not yet framed (0: none)
+#if SDFG_LAYER_VULKAN
+  std::vector<VkDepthRect> lastRegions;  // what that copy holds
+#endif
+  // Per layer: the view last submitted from it (world, the whole rect) and the rect's offset in
+  // the image, which place the next copy.
+  struct SeenView {
+    DepthView view;
+    int32_t x = 0, y = 0;
+  };
+  std::vector<std::optional<SeenView>> seen;
 };
 
 // What the layer reads of one frame's depth, waiting for its copies.
@@ -77,6 +94,9 @@ struct SessionDepth {
   std::deque<DepthFrame> frames;  // oldest first, at most kMaxFramesWaiting
   std::vector<uint64_t> orphans;  // copies no frame took: discarded at the next claim
   uint64_t framesSubmitted = 0;   // handed to the engine
+  // The hands' fusion boxes (world) at the last xrEndFrame, grown by the motion a frame or two
+  // may bring; empty while no hand is known (nothing would be fused).
+  std::vector<std::pair<glm::vec3, glm::vec3>> boxes;
   bool refusedLogged = false, multisampleLogged = false, badInfoLogged = false,
        unknownLogged = false, failedLogged = false;
 };

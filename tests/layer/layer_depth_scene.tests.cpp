@@ -327,8 +327,11 @@ TEST_CASE("Reversed, infinite-far and lower-resolution depth are read as the app
     c.options.width = c.options.height = 160;
     c.options.format = VK_FORMAT_D16_UNORM;
   }
-  SECTION("depth larger than the layer reads (640 pixels, read every other)") {
+  SECTION("depth larger than the layer reads (640 pixels: the hand's part whole)") {
     c.options.width = c.options.height = 640;
+  }
+  SECTION("a headset's depth (1280 pixels: the hand's part read every other)") {
+    c.options.width = c.options.height = 1280;
   }
   checkClosedOn(runApp(c), "convention");
 }
@@ -410,6 +413,69 @@ TEST_CASE("depth_scene = off reads no depth", "[layer][depth]") {
   c.extra = {{"SDFG_AUTOGRASP_DEPTH_SCENE", "off"}};
   c.expectDepth = false;
   checkClosedThrough(runApp(c));
+}
+
+// The layer copies only the pixels that can see a hand's fusion box (docs/depth.md): a hand
+// behind the head costs no copy at all after the first frame, and the first frames with it in
+// sight are read again.
+TEST_CASE("Depth is read only where a hand is in sight", "[layer][depth]") {
+  if (const std::string why = vulkanUnavailable(); !why.empty()) SDFG_SKIP(why);
+  XrEnv env;
+  env.handTracking = "absent";
+  // Both hands behind the head (the left one too: its controller's default is in sight).
+  const XrPosef behind{{0, 0, 0, 1}, {0.2f, -0.3f, 0.4f}};
+  const XrPosef leftBehind{{0, 0, 0, 1}, {-0.2f, -0.3f, 0.4f}};
+  env.script = gripLine(0, "right", behind) + squeezeLine(0, "right", 0.0f) +
+               gripLine(0, "left", leftBehind);
+  env.extra = {{"SDFG_AUTOGRASP_DEPTH_SCENE", "on"}};
+  applyEnv(env);
+  AppOptions ao{{XR_EXT_HAND_TRACKING_EXTENSION_NAME, XR_KHR_COMPOSITION_LAYER_DEPTH_EXTENSION_NAME,
+                 XR_SDFG_AUTO_GRASP_EXTENSION_NAME}};
+  ao.graphics = Graphics::vulkan2;
+  App app(ao);
+  REQUIRE(app.ok());
+  const XrHandTrackerEXT tracker = rightTracker(app);
+  DepthSubmitOptions options;
+  options.width = options.height = 320;
+  DepthSubmitter depth(app, options);
+  REQUIRE(depth.ok());
+  const Drawn drawn;
+  const auto framesRead = [&] {
+    return rightHandOutput(app, XrGraspDepthSceneInfoSDFG{XR_TYPE_GRASP_DEPTH_SCENE_INFO_SDFG})
+        .framesRead;
+  };
+  const auto frame = [&] {
+    app.frame([&] {
+      REQUIRE(depth.submit(
+          [&](const XrView& v, uint32_t w, uint32_t h) { return drawn.render(v, w, h); }));
+    });
+    Joints j;
+    REQUIRE(locateJoints(app, tracker, j) == XR_SUCCESS);
+    std::this_thread::sleep_for(kFramePeriod);
+  };
+  // Until the layer has seen the views and the hand (its first copies are whole: no view placed
+  // them yet), then 60 frames and a second more.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (depth.submitted() < 10) frame();
+  const uint32_t before = framesRead();
+  CHECK(before <= 6);
+  const auto since = std::chrono::steady_clock::now();
+  for (int n = 0; n < 60 || std::chrono::steady_clock::now() - since < std::chrono::seconds(1);
+       ++n) {
+    REQUIRE(std::chrono::steady_clock::now() < deadline);
+    frame();
+  }
+  CHECK(framesRead() == before);
+  // The hand comes into sight: its depth is read and fused.
+  const uint64_t next = app.framesEnded + 1;
+  REQUIRE(app.setScript(gripLine(next, "right", kRightGrip) + squeezeLine(next, "right", 0.0f) +
+                        gripLine(next, "left", leftBehind)) == XR_SUCCESS);
+  while (!depthReady(app) || framesRead() < before + 10) {
+    REQUIRE(std::chrono::steady_clock::now() < deadline);
+    frame();
+  }
+  CHECK(validationLog().empty());
+  CHECK(vulkanMessages().empty());
 }
 
 // The outer hand on depth: an open hand the user lowers 3 cm into a table the app draws (and

@@ -164,6 +164,57 @@ TEST_CASE("Depth view: a pixel's ray and a point's projection agree", "[depth]")
 }
 
 TEST_CASE(
+    "Depth view: a box's cover holds every pixel whose ray meets it, and a crop reads the same",
+    "[depth]") {
+  const DepthView v = headView();
+  const glm::vec3 centre(0.0f, 0.05f, 0.0f), half(0.12f);
+  const auto rect = v.cover(centre - half, centre + half);
+  REQUIRE(rect.has_value());
+  CHECK(rect->width < v.width);  // a 24 cm box 40 cm away is not the whole view
+  CHECK(rect->height < v.height);
+  const DepthView c = v.crop(*rect);
+  REQUIRE_FALSE(c.validate().has_value());
+  CHECK(c.width == rect->width);
+  // Every pixel of the view whose ray passes through the box lies in the rect, and the crop's
+  // pixel at the same place has the same ray.
+  size_t through = 0;
+  for (uint32_t y = 0; y < v.height; y += 7) {
+    for (uint32_t x = 0; x < v.width; x += 7) {
+      const glm::vec2 px(float(x) + 0.5f, float(y) + 0.5f);
+      const glm::vec3 dir = v.worldFromView.transformVector(v.ray(px));
+      // Slab test of the ray from the eye against the box.
+      const glm::vec3 o = v.worldFromView.position;
+      float t0 = 0.0f, t1 = 1e9f;
+      for (int a = 0; a < 3; ++a) {
+        const float lo = (centre[a] - half[a] - o[a]) / dir[a];
+        const float hi = (centre[a] + half[a] - o[a]) / dir[a];
+        t0 = std::max(t0, std::min(lo, hi));
+        t1 = std::min(t1, std::max(lo, hi));
+      }
+      if (t0 > t1) continue;
+      ++through;
+      const bool inside =
+          x >= rect->x && x < rect->x + rect->width && y >= rect->y && y < rect->y + rect->height;
+      REQUIRE(inside);
+      const glm::vec2 inCrop = px - glm::vec2(float(rect->x), float(rect->y));
+      const glm::vec3 a = glm::normalize(v.ray(px)), b = glm::normalize(c.ray(inCrop));
+      CHECK(glm::length(a - b) < 1e-5f);
+    }
+  }
+  CHECK(through > 100);
+  // Behind the view: nothing; straddling the eye plane: the whole view.
+  const glm::vec3 back = v.worldFromView.transformPoint(glm::vec3(0.0f, 0.0f, 0.5f));
+  CHECK_FALSE(v.cover(back - half, back + half).has_value());
+  const glm::vec3 eye = v.worldFromView.position;
+  const auto whole = v.cover(eye - half, eye + half);
+  REQUIRE(whole.has_value());
+  CHECK((whole->x == 0 && whole->y == 0 && whole->width == v.width && whole->height == v.height));
+  // Off to the side of the frustum: nothing.
+  const glm::vec3 side = v.worldFromView.transformPoint(glm::vec3(2.0f, 0.0f, -0.4f));
+  CHECK_FALSE(v.cover(side - half, side + half).has_value());
+}
+
+TEST_CASE(
     "Depth fusion: a mug on a table seen from 40 cm is known where it is seen, in every "
     "stored convention",
     "[depth]") {

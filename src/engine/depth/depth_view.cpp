@@ -1,5 +1,6 @@
 #include "depth/depth_view.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -82,6 +83,51 @@ bool DepthView::project(const glm::vec3& p, glm::vec2& pixel, float& z) const {
   pixel.x = (v.x / z - tl) / (tr - tl) * float(width);
   pixel.y = (tu - v.y / z) / (tu - td) * float(height);
   return true;
+}
+
+std::optional<DepthPixelRect> DepthView::cover(const glm::vec3& lo, const glm::vec3& hi) const {
+  const Pose viewFromWorld = worldFromView.inverse();
+  const float tl = std::tan(fov.left), tr = std::tan(fov.right);
+  const float tu = std::tan(fov.up), td = std::tan(fov.down);
+  float x0 = std::numeric_limits<float>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+  int behind = 0;
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+    const glm::vec3 v = viewFromWorld.transformPoint(corner);
+    const float z = -v.z;
+    if (!(z > 1e-3f)) {
+      ++behind;
+      continue;
+    }
+    const float px = (v.x / z - tl) / (tr - tl) * float(width);
+    const float py = (tu - v.y / z) / (tu - td) * float(height);
+    x0 = std::min(x0, px);
+    x1 = std::max(x1, px);
+    y0 = std::min(y0, py);
+    y1 = std::max(y1, py);
+  }
+  if (behind == 8) return std::nullopt;
+  if (behind > 0) return DepthPixelRect{0, 0, width, height};
+  // A box is convex: its projection lies within its corners' projections.
+  const float left = std::max(std::floor(x0), 0.0f), top = std::max(std::floor(y0), 0.0f);
+  const float right = std::min(std::ceil(x1), float(width));
+  const float bottom = std::min(std::ceil(y1), float(height));
+  if (!(left < right && top < bottom)) return std::nullopt;
+  return DepthPixelRect{uint32_t(left), uint32_t(top), uint32_t(right - left),
+                        uint32_t(bottom - top)};
+}
+
+DepthView DepthView::crop(const DepthPixelRect& rect) const {
+  const float tl = std::tan(fov.left), tr = std::tan(fov.right);
+  const float tu = std::tan(fov.up), td = std::tan(fov.down);
+  DepthView out = *this;
+  out.fov.left = std::atan(tl + float(rect.x) / float(width) * (tr - tl));
+  out.fov.right = std::atan(tl + float(rect.x + rect.width) / float(width) * (tr - tl));
+  out.fov.up = std::atan(tu - float(rect.y) / float(height) * (tu - td));
+  out.fov.down = std::atan(tu - float(rect.y + rect.height) / float(height) * (tu - td));
+  out.width = rect.width;
+  out.height = rect.height;
+  return out;
 }
 
 }  // namespace sdfg

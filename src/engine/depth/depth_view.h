@@ -21,6 +21,11 @@
 
 namespace sdfg {
 
+// Pixels [x, x + width) x [y, y + height) of a view's rect.
+struct DepthPixelRect {
+  uint32_t x = 0, y = 0, width = 0, height = 0;
+};
+
 // Radians, as XrFovf: left and down negative for a view that straddles its axis.
 struct DepthFov {
   float left = 0.0f, right = 0.0f, up = 0.0f, down = 0.0f;
@@ -50,6 +55,14 @@ struct DepthView {
   glm::vec3 ray(const glm::vec2& pixel) const;
   // Where world point `p` falls: its pixel position and view distance; false behind the view.
   bool project(const glm::vec3& p, glm::vec2& pixel, float& z) const;
+
+  // The pixels whose rays can meet the world box [lo, hi]: the bounds of its corners' projections,
+  // grown to whole pixels, within the view. The whole view when the box reaches to within 1 mm of
+  // the view's eye plane (its projection is unbounded there); nullopt when no ray meets it.
+  std::optional<DepthPixelRect> cover(const glm::vec3& lo, const glm::vec3& hi) const;
+  // The view of `rect` alone, a rect within this view: the same pose, depth range and planes, the
+  // field of view narrowed to the rect's edges, rect's size.
+  DepthView crop(const DepthPixelRect& rect) const;
 };
 
 }  // namespace sdfg

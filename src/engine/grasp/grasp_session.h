@@ -296,6 +296,13 @@ class GraspSession {
   }
   // What the worker last fused near `hand` (valid: a frame was fused).
   const GraspWorker::DepthDone& depthState(Hand hand) const { return depthDone_[size_t(hand)]; }
+  // Where each hand's depth is fused as of the last update (world, axis-aligned, the cube of
+  // DepthFusionOptions::size): only pixels whose rays meet one of these matter to the scene, so a
+  // caller that reads depth may read those alone. nullopt for a hand no update has seen.
+  struct DepthBox {
+    glm::vec3 lo{0.0f}, hi{0.0f};
+  };
+  std::array<std::optional<DepthBox>, 2> depthBoxes() const;
 
   // Advances one hand, with the spaces where they are this frame (targets in spaces not listed,
   // or not valid, take part in nothing this frame). Returns the first error met while solving (the
@@ -477,6 +484,7 @@ class GraspSession {
   std::map<uint64_t, Target> targets_;
   SceneIndex index_;
   bool depthOn_ = false;
+  float depthBoxSize_ = DepthFusionOptions{}.size;  // the fusion's cube, as enableDepthScene set
   std::array<GraspWorker::DepthDone, 2> depthDone_{};
   std::vector<std::pair<uint64_t, MeshSetupReport>> setupReports_;
   std::vector<uint64_t> pendingSetups_;  // ids whose set-up may still be running (refreshSetups)

@@ -39,7 +39,21 @@ Status GraspSession::enableDepthScene(const DepthFusionOptions& options) {
     targets_.emplace(id, std::move(t));  // placed once a frame is fused (collectDepth)
   }
   depthOn_ = true;
+  depthBoxSize_ = options.size;
   return Status::ok;
+}
+
+std::array<std::optional<GraspSession::DepthBox>, 2> GraspSession::depthBoxes() const {
+  std::array<std::optional<DepthBox>, 2> out;
+  for (size_t slot = 0; slot < 2; ++slot) {
+    const HandState& hand = hands_[slot];
+    if (!hand.lastWrist) continue;
+    // The same centre submitDepth() fuses around; recentre() rounds it by half a voxel at most.
+    const glm::vec3 c = (*hand.lastWrist * settings_.box.handFromBox).position;
+    const glm::vec3 half(0.5f * depthBoxSize_);
+    out[slot] = DepthBox{c - half, c + half};
+  }
+  return out;
 }
 
 Status GraspSession::submitDepth(std::vector<DepthView> views,

@@ -27,6 +27,11 @@ uint32_t depthTexelBytes(VkFormat f) {
   }
 }
 
+bool inside(const VkDepthImage& im, const VkDepthRect& r) {
+  return r.layer < im.layers && r.x >= 0 && r.y >= 0 && r.width > 0 && r.height > 0 &&
+         uint64_t(r.x) + r.width <= im.width && uint64_t(r.y) + r.height <= im.height;
+}
+
 bool hasStencil(VkFormat f) {
   return f == VK_FORMAT_D16_UNORM_S8_UINT || f == VK_FORMAT_D24_UNORM_S8_UINT ||
          f == VK_FORMAT_D32_SFLOAT_S8_UINT;
@@ -62,6 +67,8 @@ struct VkDepthCapture::Slot {
   bool discarded = false;  // the caller is done with it: free once finished
   uint64_t ticket = 0;
   VkDepthImage image;
+  std::vector<VkDepthRect> regions;
+  std::vector<VkDeviceSize> offsets;     // per region: where its texels start in the buffer
   VkCommandBuffer cmd = VK_NULL_HANDLE;  // from pool_
   VkOwned<VkFence> fence;
   VkBufferAlloc buffer;  // grown to the largest image copied
@@ -159,12 +166,24 @@ void VkDepthCapture::retire() {
   }
 }
 
-Result<uint64_t> VkDepthCapture::submit(const VkDepthImage& image) {
+Result<uint64_t> VkDepthCapture::submit(const VkDepthImage& image,
+                                        std::span<const VkDepthRect> regions) {
   if (failed_) return makeError(Status::device_lost, "depth capture: the device failed before");
   const uint32_t bytes = depthTexelBytes(image.format);
   if (bytes == 0 || image.image == VK_NULL_HANDLE || image.width == 0 || image.height == 0 ||
       image.layers == 0)
     return makeError(Status::invalid_argument, "depth capture: not a readable depth image");
+  if (regions.empty() || regions.size() > 64)
+    return makeError(Status::invalid_argument, "depth capture: no region, or too many");
+  std::vector<VkDeviceSize> offsets;
+  VkDeviceSize size = 0;
+  for (const VkDepthRect& r : regions) {
+    if (!inside(image, r))
+      return makeError(Status::invalid_argument, "depth capture: a region outside the image");
+    offsets.push_back(size);
+    // Each region starts 4-byte aligned, as a buffer copy's offset must for depth.
+    size += (VkDeviceSize(r.width) * r.height * bytes + 3) & ~VkDeviceSize(3);
+  }
   retire();
   Slot* slot = nullptr;
   for (auto& s : slots_)
@@ -173,7 +192,6 @@ Result<uint64_t> VkDepthCapture::submit(const VkDepthImage& image) {
 
   const VkContext& c = *ctx_;
   const VkFunctions& fn = c.fn();
-  const VkDeviceSize size = VkDeviceSize(image.width) * image.height * image.layers * bytes;
   if (slot->buffer.size < size) {
     slot->buffer = VkBufferAlloc{};
     auto made = createBuffer(c, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, VkMemoryKind::readback);
@@ -204,11 +222,16 @@ Result<uint64_t> VkDepthCapture::submit(const VkDepthImage& image) {
   toSrc.subresourceRange = {aspects, 0, 1, 0, image.layers};
   fn.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                           0, 0, nullptr, 0, nullptr, 1, &toSrc);
-  VkBufferImageCopy region{};
-  region.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, image.layers};
-  region.imageExtent = {image.width, image.height, 1};
+  std::vector<VkBufferImageCopy> copies(regions.size());
+  for (size_t i = 0; i < regions.size(); ++i) {
+    const VkDepthRect& r = regions[i];
+    copies[i].bufferOffset = offsets[i];
+    copies[i].imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, r.layer, 1};
+    copies[i].imageOffset = {r.x, r.y, 0};
+    copies[i].imageExtent = {r.width, r.height, 1};
+  }
   fn.vkCmdCopyImageToBuffer(cmd, image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                            slot->buffer.buffer.get(), 1, &region);
+                            slot->buffer.buffer.get(), uint32_t(copies.size()), copies.data());
   // Back to the layout the runtime is promised; whatever it does next (sample, copy, attach)
   // waits for the copy's read.
   auto back = toSrc;
@@ -238,6 +261,8 @@ Result<uint64_t> VkDepthCapture::submit(const VkDepthImage& image) {
   slot->discarded = false;
   slot->ticket = nextTicket_++;
   slot->image = image;
+  slot->regions.assign(regions.begin(), regions.end());
+  slot->offsets = std::move(offsets);
   return slot->ticket;
 }
 
@@ -260,23 +285,32 @@ bool VkDepthCapture::finished(uint64_t ticket) {
 std::vector<float> VkDepthCapture::read(uint64_t ticket, const VkDepthRect& rect,
                                         uint32_t step) const {
   const Slot* s = slotOf(ticket);
-  if (s == nullptr || s->state != Slot::State::finished || step == 0) return {};
-  const VkDepthImage& im = s->image;
-  if (rect.layer >= im.layers || rect.x < 0 || rect.y < 0 || rect.width == 0 || rect.height == 0 ||
-      uint64_t(rect.x) + rect.width > im.width || uint64_t(rect.y) + rect.height > im.height)
+  if (s == nullptr || s->state != Slot::State::finished || step == 0 || rect.width == 0 ||
+      rect.height == 0)
     return {};
+  // The region of the rect's layer that holds it.
+  size_t k = 0;
+  for (; k < s->regions.size(); ++k) {
+    const VkDepthRect& r = s->regions[k];
+    if (r.layer == rect.layer && rect.x >= r.x && rect.y >= r.y &&
+        int64_t(rect.x) + rect.width <= int64_t(r.x) + r.width &&
+        int64_t(rect.y) + rect.height <= int64_t(r.y) + r.height)
+      break;
+  }
+  if (k == s->regions.size()) return {};
   if (invalidateBuffer(*ctx_, s->buffer) != VK_SUCCESS) return {};
-  const uint32_t bytes = depthTexelBytes(im.format);
-  const auto* base = static_cast<const unsigned char*>(s->buffer.mapped) +
-                     size_t(rect.layer) * im.width * im.height * bytes;
+  const VkDepthRect& region = s->regions[k];
+  const uint32_t bytes = depthTexelBytes(s->image.format);
+  const auto* base = static_cast<const unsigned char*>(s->buffer.mapped) + s->offsets[k];
   const uint32_t w = (rect.width + step - 1) / step, h = (rect.height + step - 1) / step;
   std::vector<float> out(size_t(w) * h);
   for (uint32_t j = 0; j < h; ++j) {
-    const uint32_t y = rect.y + std::min(j * step + step / 2, rect.height - 1);
-    const unsigned char* row = base + size_t(y) * im.width * bytes;
+    const uint32_t y = uint32_t(rect.y - region.y) + std::min(j * step + step / 2, rect.height - 1);
+    const unsigned char* row = base + size_t(y) * region.width * bytes;
     for (uint32_t i = 0; i < w; ++i) {
-      const uint32_t x = rect.x + std::min(i * step + step / 2, rect.width - 1);
-      out[size_t(j) * w + i] = storedValue(im.format, row + size_t(x) * bytes);
+      const uint32_t x =
+          uint32_t(rect.x - region.x) + std::min(i * step + step / 2, rect.width - 1);
+      out[size_t(j) * w + i] = storedValue(s->image.format, row + size_t(x) * bytes);
     }
   }
   return out;
@@ -310,6 +344,7 @@ bool VkDepthCapture::forget(VkImage image, uint64_t timeoutNs) {
       s->discarded = false;
       s->ticket = 0;
       s->image = {};
+      s->regions.clear();
     } else {
       s->discarded = true;
     }

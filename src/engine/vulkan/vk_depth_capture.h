@@ -1,7 +1,8 @@
-// An app's depth images brought to the CPU for the depth scene (depth/depth_fusion.h): each copy
-// is recorded and submitted on the app's queue right after the app's rendering and before the
-// runtime takes the image, into a host-visible buffer of the layer's own, and read once its fence
-// signals, a frame or more later. Nothing here waits for the GPU, except teardown (wait()).
+// An app's depth images brought to the CPU for the depth scene (depth/depth_fusion.h): each copy,
+// of the rects the caller needs (the pixels that see a hand's box, not the whole image), is
+// recorded and submitted on the app's queue right after the app's rendering and before the runtime
+// takes the image, into a host-visible buffer of the layer's own, and read once its fence signals,
+// a frame or more later. Nothing here waits for the GPU, except teardown (wait()).
 //
 // What an app guarantees at xrReleaseSwapchainImage (XR_KHR_vulkan_enable): the depth image is
 // in VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL and its rendering was submitted on the
@@ -19,6 +20,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -58,18 +60,19 @@ class VkDepthCapture {
   // Whether copies of `format`'s depth aspect can be read: D16, X8_D24, D24S8, D32, D32S8.
   static bool readableFormat(VkFormat format);
 
-  // Records and submits the copy of every layer of `image` whole; returns its ticket (> 0) at
-  // once. Errors: invalid_argument (a format readableFormat() refuses, an empty image),
-  // unsupported (every slot busy: the copies before it are not finished or not yet taken),
-  // device_lost / out_of_memory / internal (the capture is unusable from then on, having logged
-  // one line).
-  Result<uint64_t> submit(const VkDepthImage& image);
+  // Records and submits the copy of `regions` of `image` (rects of its layers, inside the image;
+  // a layer may appear more than once), packed into one buffer; returns its ticket (> 0) at once.
+  // Errors: invalid_argument (a format readableFormat() refuses, an empty image, no region, a
+  // region empty or outside the image), unsupported (every slot busy: the copies before it are not
+  // finished or not yet taken), device_lost / out_of_memory / internal (the capture is unusable
+  // from then on, having logged one line).
+  Result<uint64_t> submit(const VkDepthImage& image, std::span<const VkDepthRect> regions);
   // Non-blocking: whether the copy `ticket` has finished (false also for an unknown ticket).
   bool finished(uint64_t ticket);
   // The stored values of `rect` of a finished copy, in [0, 1], row by row from the rect's top,
   // read every `step` pixels from `step / 2` (step 1: every pixel); the output is
   // ceil(width / step) x ceil(height / step). Empty when the ticket is not finished or the rect is
-  // not inside the image.
+  // not inside one region the copy was made of.
   std::vector<float> read(uint64_t ticket, const VkDepthRect& rect, uint32_t step) const;
   // Whether `ticket` is a copy in flight or finished and not freed.
   bool holds(uint64_t ticket) const { return slotOf(ticket) != nullptr; }

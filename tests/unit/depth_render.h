@@ -1,7 +1,6 @@
-// Depth images for the depth scene's tests: a small z-buffer rasterizer that renders meshes as an
-// app's depth pass would, from a view (depth/depth_view.h), into the stored values of each format
-// apps submit (D16 and D24 quantized, D32 float), and the scene they share (the embedded mug on a
-// table, seen from a head 40 cm away).
+// Depth images for the depth scene's tests: the benchmark's rasterizer (eval/depth_render.h) under
+// the tests' names, and the scene they share (the embedded mug on a table, seen from a head 40 cm
+// away).
 #pragma once
 
 #include <algorithm>
@@ -15,93 +14,25 @@
 #include <glm/mat3x3.hpp>
 
 #include "depth/depth_view.h"
+#include "eval/depth_render.h"
 #include "io/shapes.h"
 #include "mesh/mesh.h"
 
 namespace sdfg::depth_test {
 
-enum class Stored { d16, d24, d32 };
-
-// A 512 x 512 view with a 90 degree field of view at `eye`, looking at `target` (world +Y up).
+// The rasterizer is the benchmark's (eval/depth_render.h); the tests' names for it.
+using Stored = DepthStored;
+using Placed = DepthPlaced;
 inline DepthView lookAt(const glm::vec3& eye, const glm::vec3& target, float nearZ, float farZ,
                         uint32_t size = 512) {
-  const glm::vec3 f = glm::normalize(target - eye);
-  const glm::vec3 r = glm::normalize(glm::cross(f, glm::vec3(0, 1, 0)));
-  const glm::vec3 u = glm::cross(r, f);
-  DepthView v;
-  v.worldFromView = Pose{glm::normalize(glm::quat_cast(glm::mat3(r, u, -f))), eye};
-  const float half = 0.25f * 3.14159265f;
-  v.fov = DepthFov{-half, half, half, -half};
-  v.width = v.height = size;
-  v.nearZ = nearZ;
-  v.farZ = farZ;
-  return v;
+  return depthLookAt(eye, target, nearZ, farZ, size);
 }
-
-struct Placed {
-  const TriangleMesh* mesh;
-  Pose worldFromObject;
-};
-
-// The view distance of the nearest surface at every pixel centre (+inf: none).
 inline std::vector<float> renderDistances(const DepthView& view, std::span<const Placed> objects) {
-  std::vector<float> z(size_t(view.width) * view.height, std::numeric_limits<float>::infinity());
-  const Pose viewFromWorld = view.worldFromView.inverse();
-  const float tl = std::tan(view.fov.left), tr = std::tan(view.fov.right);
-  const float tu = std::tan(view.fov.up), td = std::tan(view.fov.down);
-  const float sx = float(view.width) / (tr - tl), sy = float(view.height) / (tu - td);
-  for (const Placed& o : objects) {
-    const TriangleMesh& m = *o.mesh;
-    for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
-      glm::vec2 s[3];
-      float zs[3];
-      bool ok = true;
-      for (int c = 0; c < 3; ++c) {
-        const glm::vec3 v = viewFromWorld.transformPoint(
-            o.worldFromObject.transformPoint(m.positions[m.indices[t + size_t(c)]]));
-        zs[c] = -v.z;
-        ok = ok && zs[c] > 0.01f;
-        s[c] = glm::vec2((v.x / zs[c] - tl) * sx, (tu - v.y / zs[c]) * sy);
-      }
-      if (!ok) continue;
-      auto edge = [](const glm::vec2& a, const glm::vec2& b, const glm::vec2& p) {
-        return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
-      };
-      const float area = edge(s[0], s[1], s[2]);
-      if (std::abs(area) < 1e-12f) continue;
-      const glm::vec2 lo = glm::min(s[0], glm::min(s[1], s[2]));
-      const glm::vec2 hi = glm::max(s[0], glm::max(s[1], s[2]));
-      const int x0 = std::max(0, int(std::floor(lo.x))), y0 = std::max(0, int(std::floor(lo.y)));
-      const int x1 = std::min(int(view.width) - 1, int(std::ceil(hi.x)));
-      const int y1 = std::min(int(view.height) - 1, int(std::ceil(hi.y)));
-      for (int y = y0; y <= y1; ++y) {
-        for (int x = x0; x <= x1; ++x) {
-          const glm::vec2 p(float(x) + 0.5f, float(y) + 0.5f);
-          const float w0 = edge(s[1], s[2], p) / area, w1 = edge(s[2], s[0], p) / area;
-          const float w2 = 1.0f - w0 - w1;
-          if (w0 < 0.0f || w1 < 0.0f || w2 < 0.0f) continue;
-          // 1 / z is affine in screen space.
-          const float d = 1.0f / (w0 / zs[0] + w1 / zs[1] + w2 / zs[2]);
-          float& out = z[size_t(y) * view.width + size_t(x)];
-          out = std::min(out, d);
-        }
-      }
-    }
-  }
-  return z;
+  return renderDepthDistances(view, objects);
 }
-
-// The stored values an app would submit for those distances.
 inline std::vector<float> storedDepth(const DepthView& view, const std::vector<float>& z,
                                       Stored format) {
-  std::vector<float> d(z.size());
-  for (size_t i = 0; i < z.size(); ++i) {
-    float v = view.storedAt(z[i]);
-    if (format == Stored::d16) v = std::round(v * 65535.0f) / 65535.0f;
-    if (format == Stored::d24) v = float(std::round(double(v) * 16777215.0) / 16777215.0);
-    d[i] = v;
-  }
-  return d;
+  return storedDepthValues(view, z, format);
 }
 
 // The mug of shapes.h standing on a table top at the world's origin, as the benchmark's scenes

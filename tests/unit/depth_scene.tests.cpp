@@ -20,6 +20,7 @@
 #include "depth_reaches.h"
 #include "depth_render.h"
 #include "eval/approaching.h"
+#include "eval/depth_quality.h"
 #include "eval/evaluator.h"
 #include "eval/placements.h"
 #include "grasp/scene_exact_source.h"
@@ -340,22 +341,9 @@ TEST_CASE("Depth fusion: a hand closes on a mug it only saw as depth, and stays 
   std::vector<float> penetrations, residuals;
   for (const Placement& pl : placements) {
     const Pose& worldFromHand = pl.objectFromHand;
-    // One frame: the scene and the view hold still, so more frames average the same values.
-    DepthFusion f = fuse(view, stored, worldFromHand.transformPoint(box.handFromBox.position), 1);
-    SceneMember m;
-    m.id = 1;
-    m.volume = &f.volume();
-    m.objectFromHand = worldFromHand;  // the volume's frame is the world
-    m.graspable = true;
-    SdfGrid grid(box), scratch(box);
-    REQUIRE(buildSceneField({&m, 1}, box, *backend, grid, scratch) == Status::ok);
-    const SceneExactSource exact({&m, 1});
-    GraspScene gs;
-    gs.field = &grid;
-    gs.objectFromHand = worldFromHand;
-    gs.exact = &exact;
     GraspResult result;
-    REQUIRE((*solver)->solve(gs, result) == Status::ok);
+    REQUIRE(solveOnDepth(view, stored, worldFromHand, box, **solver, *backend, result) ==
+            Status::ok);
     // Against the true surfaces: each finger's gap to the nearest of the mug and the table.
     const TrueGrade grade = gradeOnTruth(truth, hand, worldFromHand, result);
     const int fingersTouching = grade.touching;

@@ -40,6 +40,31 @@ Result<WorldSolid> worldSolid(const SceneObject& o) {
 
 }  // namespace
 
+Status solveOnDepth(const DepthView& view, std::span<const float> stored, const Pose& worldFromHand,
+                    const GridBox& box, GraspSolver& solver, SdfBackend& backend,
+                    GraspResult& out) {
+  auto made = DepthFusion::create(DepthFusionOptions{});
+  if (!made) return made.error().code;
+  DepthFusion fusion = std::move(*made);
+  fusion.recentre(worldFromHand.transformPoint(box.handFromBox.position));
+  // One frame: the scene and the view hold still, so more frames average the same values.
+  if (Status s = fusion.integrate(view, stored, {}, 0.0); s != Status::ok) return s;
+  fusion.finishFrame(0.0);
+  SceneMember m;
+  m.id = 1;
+  m.volume = &fusion.volume();
+  m.objectFromHand = worldFromHand;  // the volume's frame is the world
+  m.graspable = true;
+  SdfGrid grid(box), scratch(box);
+  if (Status s = buildSceneField({&m, 1}, box, backend, grid, scratch); s != Status::ok) return s;
+  const SceneExactSource exact({&m, 1});
+  GraspScene gs;
+  gs.field = &grid;
+  gs.objectFromHand = worldFromHand;
+  gs.exact = &exact;
+  return solver.solve(gs, out);
+}
+
 Result<DepthQuality> depthSceneQuality(const BenchScene& scene, const HandModel& hand,
                                        const GridBox& box, GraspSolver& solver, SdfBackend& backend,
                                        const DepthQualityOptions& options) {
@@ -99,30 +124,10 @@ Result<DepthQuality> depthSceneQuality(const BenchScene& scene, const HandModel&
         continue;
       ++fig.reaches;
       const Pose& worldFromHand = pl.objectFromHand;  // the object's mesh is in the world
-      // One frame: the scene and the view hold still, so more frames average the same values.
-      auto made = DepthFusion::create(DepthFusionOptions{});
-      if (!made) return made.error();
-      DepthFusion fusion = std::move(*made);
-      fusion.recentre(worldFromHand.transformPoint(box.handFromBox.position));
-      if (Status s = fusion.integrate(view, stored, {}, 0.0); s != Status::ok)
-        return makeError(s, "depth quality: the view was refused");
-      fusion.finishFrame(0.0);
-      SceneMember m;
-      m.id = 1;
-      m.volume = &fusion.volume();
-      m.objectFromHand = worldFromHand;  // the volume's frame is the world
-      m.graspable = true;
-      SdfGrid grid(box), scratch(box);
-      if (Status s = buildSceneField({&m, 1}, box, backend, grid, scratch); s != Status::ok)
-        return makeError(s, "depth quality: the field's build failed");
-      const SceneExactSource exact({&m, 1});
-      GraspScene gs;
-      gs.field = &grid;
-      gs.objectFromHand = worldFromHand;
-      gs.exact = &exact;
       GraspResult result;
-      if (Status s = solver.solve(gs, result); s != Status::ok)
-        return makeError(s, "depth quality: the solve failed");
+      if (Status st = solveOnDepth(view, stored, worldFromHand, box, solver, backend, result);
+          st != Status::ok)
+        return makeError(st, "depth quality: the fusion, the field's build or the solve failed");
       // Each finger against the nearest true surface.
       std::array<float, kFingerCount> gap;
       gap.fill(1e30f);

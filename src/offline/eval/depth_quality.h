@@ -13,10 +13,12 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "base/status.h"
+#include "depth/depth_view.h"
 #include "eval/scenes.h"
 #include "grasp/solver.h"
 #include "hand/hand_model.h"
@@ -43,6 +45,12 @@ struct DepthQuality {
   std::string scene;
   std::vector<DepthReachFigures> reaches;
 };
+
+// One grasp on depth alone: `stored` (the view's values) fused once into the volume around the
+// hand at `worldFromHand` (its grab box's centre), the grab-box field built from that volume, and
+// `solver` closing on it. Errors: those of the fusion (a view it refuses), the build and the solve.
+Status solveOnDepth(const DepthView& view, std::span<const float> stored, const Pose& worldFromHand,
+                    const GridBox& box, GraspSolver& solver, SdfBackend& backend, GraspResult& out);
 
 // Errors: invalid_argument (a scene without its object and a table, a solver that is not
 // prepared for `hand` and `box`), and those of the meshes' exact queries and the field's build.

@@ -31,6 +31,18 @@ std::shared_ptr<const ShownHand> shownHand(const SessionState& s, Hand hand) {
   return s.shown[hand == Hand::left ? 0 : 1].load();
 }
 
+// No hand this frame: not active, no joint or velocity valid (the spec's lost hand).
+void withholdHand(XrHandJointLocationsEXT& locations) {
+  locations.isActive = XR_FALSE;
+  if (locations.jointLocations != nullptr)
+    for (auto& l : std::span(locations.jointLocations, locations.jointCount)) l.locationFlags = 0;
+  auto* velocities =
+      findInChain<XrHandJointVelocitiesEXT>(locations.next, XR_TYPE_HAND_JOINT_VELOCITIES_EXT);
+  if (velocities != nullptr && velocities->jointVelocities != nullptr)
+    for (auto& v : std::span(velocities->jointVelocities, velocities->jointCount))
+      v.velocityFlags = 0;
+}
+
 }  // namespace
 
 XrResult XRAPI_CALL SdfgXrCreateHandTrackerEXT(XrSession session,
@@ -169,7 +181,12 @@ XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT tracker,
       JointPoses joints;
       for (int j = 0; j < kJointCount; ++j) joints[j] = toPose(locations->jointLocations[j].pose);
       std::array<bool, kJointCount> changed{};
-      drawTrackedHand(*view, joints, changed);
+      if (!drawTrackedHand(*view, joints, changed)) {
+        // It may be inside something and nothing places it yet (outer_view.h): not tracked
+        // this frame, as a runtime reports a hand it lost.
+        withholdHand(*locations);
+        return r;
+      }
       for (int j = 0; j < kJointCount; ++j)
         if (changed[size_t(j)]) locations->jointLocations[j].pose = toXr(joints[size_t(j)]);
     } catch (...) {
@@ -261,7 +278,11 @@ XrResult XRAPI_CALL SdfgXrLocateHandJointsEXT(XrHandTrackerEXT tracker,
   const ShownHand& view = published != nullptr ? *published : fallback;
   JointPoses joints;
   JointRadii radii;
-  drawGripHand(view, *baseFromGrip, range, joints, radii);
+  if (!drawGripHand(view, *baseFromGrip, range, joints, radii)) {
+    withholdHand(*locations);
+    writeDataSourceState(inst, *t, locations, XR_HAND_TRACKING_DATA_SOURCE_CONTROLLER_EXT);
+    return XR_SUCCESS;
+  }
   for (int j = 0; j < kJointCount; ++j) {
     XrHandJointLocationEXT& l = locations->jointLocations[j];
     l.pose = toXr(joints[j]);

@@ -342,3 +342,68 @@ TEST_CASE("Outer hand: a table rising into a still open hand pushes it out of it
   CHECK(out);
   CHECK(validationLog().empty());
 }
+
+TEST_CASE(
+    "Outer hand: a hand that jumps 50 cm is shown at once on a clear pose, and never inside "
+    "the table it lands in",
+    "[layer][outer_hand]") {
+  // A controller-driven hand held 5 cm over a table, then in one frame 50 cm along it (tracking
+  // lost and found elsewhere, or the app teleporting the user): onto a pose 5 cm over it, or 1 cm
+  // into it. Located as apps do, right after the sync, paced at 90 Hz.
+  const Slab table = slabUnderPalm({0.4f, 0.02f, 0.4f});
+  const OpenRightHand hand = openRightHand(kGrip);
+  const XrPosef from = shifted(kGrip, hand.across * -0.25f - hand.down * 0.05f);
+  const bool inside = GENERATE(false, true);
+  const XrPosef landing =
+      shifted(kGrip, hand.across * 0.25f + hand.down * (inside ? 0.013f : -0.05f));
+  XrEnv env;
+  env.handTracking = "absent";
+  env.script = gripLine(0, "right", from) + squeezeLine(0, "right", 0.0f);
+  applyEnv(env);
+  App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}});
+  REQUIRE(app.ok());
+  Ext ext(app);
+  const XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
+  makeShapeTarget(app, ext, XR_GRASP_SHAPE_TYPE_BOX_SDFG, table.half, table.pose,
+                  XR_GRASP_TARGET_ROLE_SCENE_SDFG);
+  REQUIRE(app.framesUntil([&] { return app.framesEnded >= 10; }));
+  REQUIRE(app.setScript(gripLine(app.framesEnded + 1, "right", landing) +
+                        squeezeLine(0, "right", 0.0f)) == XR_SUCCESS);
+  auto next = std::chrono::steady_clock::now();
+  std::vector<Joints> located(60);
+  for (Joints& j : located) {
+    next += std::chrono::microseconds(11111);
+    std::this_thread::sleep_until(next);
+    XrResult r = XR_ERROR_RUNTIME_FAILURE;
+    app.frame([&] { r = locateJoints(app, tracker, j); });
+    REQUIRE(r == XR_SUCCESS);
+  }
+  int withheld = 0;
+  float deepest = -1.0f;
+  for (const Joints& j : located) {
+    if (!j.locations.isActive) {
+      ++withheld;
+      // Not tracked this frame: no joint is valid either.
+      CHECK(std::all_of(j.joints.begin(), j.joints.end(),
+                        [](const XrHandJointLocationEXT& l) { return l.locationFlags == 0; }));
+      continue;
+    }
+    deepest = std::max(deepest, depthIn(j, table));
+  }
+  std::printf("jump of 50 cm %s: %d of 60 frames withheld, shown at most %.2f mm inside\n",
+              inside ? "into the table" : "onto a clear pose", withheld, 1000.0f * deepest);
+  CHECK(deepest <= 0.001f);
+  CHECK(located.back().locations.isActive);  // the worker placed it within 60 frames
+  if (!inside) {
+    // The first frame after the jump has no hand but the new one, as the runtime gives it.
+    CHECK(withheld == 0);
+    CHECK(sameJoints(located.front(), located.back()));
+  } else {
+    // Where it landed, clear of the table: not back where it jumped from.
+    const glm::vec3 wrist = toPose(located.back().joints[XR_HAND_JOINT_WRIST_EXT].pose).position;
+    const glm::vec3 want =
+        toPose(landing).position;  // the grip; the wrist is a few cm from it, not 50
+    CHECK(glm::length(wrist - want) < 0.15f);
+  }
+  CHECK(validationLog().empty());
+}

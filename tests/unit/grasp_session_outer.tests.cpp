@@ -46,6 +46,7 @@ struct Rig {
   // answer of every frame is exactly one frame late, as for an app that draws right after its
   // sync on a machine whose worker keeps up (the same on every machine, sanitizers included).
   bool oneFrameLate = false;
+  bool shown = true;  // the last frame drew a hand (drawTrackedHand: not withheld)
   std::chrono::steady_clock::time_point next = std::chrono::steady_clock::now();
 
   explicit Rig(bool outer = true) {
@@ -93,7 +94,7 @@ struct Rig {
     const ShownHand view = takeShownHand(session, Hand::right, HandOffset{}, squeeze);
     JointPoses drawn = world;
     std::array<bool, kJointCount> changed{};
-    drawTrackedHand(view, drawn, changed);
+    shown = drawTrackedHand(view, drawn, changed);
     if (oneFrameLate) {
       session.holdWorker(false);
       REQUIRE(session.waitWorkerIdle(5000ms));
@@ -443,8 +444,8 @@ TEST_CASE("Session outer hand: tracking lost for 20 frames and found inside a bo
           "[core][outer_hand]") {
   // Drawn right after each update, the worker's answer one frame late. The hand near a box, then
   // 20 frames without tracking, then found 1 cm into the box's top. The frame it is found is
-  // drawn before any answer for it (the tracked pose: a hand can only be known clear by the
-  // worker); from the next frame on it is shown at the nearest clear pose.
+  // drawn before any answer for it: no hand is shown then (it is within the box's bounds);
+  // from the next frame on it is shown at the nearest clear pose.
   Rig rig;
   rig.oneFrameLate = true;
   const AnalyticShape box{ShapeKind::box, glm::vec3(0.05f)};
@@ -462,12 +463,14 @@ TEST_CASE("Session outer hand: tracking lost for 20 frames and found inside a bo
   std::vector<float> depths;
   for (int k = 0; k < 30; ++k) {
     const JointPoses drawn = rig.frame(inside);
-    if (k > 0) depths.push_back(depthIn(drawn, rig.radii, box, rig.targets[0].worldFromObject));
+    if (k == 0) CHECK_FALSE(rig.shown);
+    if (k > 0) REQUIRE(rig.shown);
+    if (rig.shown) depths.push_back(depthIn(drawn, rig.radii, box, rig.targets[0].worldFromObject));
   }
   const float deepest = *std::max_element(depths.begin(), depths.end());
   std::printf(
-      "found 1 cm inside a box after 20 frames lost: from the next frame on at most %.2f mm "
-      "inside\n",
+      "found 1 cm inside a box after 20 frames lost: not shown the first frame, then at most "
+      "%.2f mm inside\n",
       1000.0f * deepest);
   CHECK(deepest <= 0.001f);
   // And squeezed there, the hand that closes is out of the box too.
@@ -488,4 +491,103 @@ TEST_CASE("Session outer hand: tracking lost for 20 frames and found inside a bo
   for (int j = 0; j < kJointCount; ++j)
     corrected[size_t(j)] = worldFromCorrected * (inside.inverse() * drawn[size_t(j)]);
   CHECK(depthIn(corrected, rig.radii, box, rig.targets[0].worldFromObject) <= 0.001f);
+}
+
+TEST_CASE(
+    "Session outer hand: a hand that appears is shown at once where no target's bounds reach "
+    "it, and not at all until the worker places it where they do",
+    "[core][outer_hand]") {
+  // Each frame drawn before the worker's answer for it (one frame late). First frames: the
+  // fallback has no result of this place.
+  const AnalyticShape box{ShapeKind::box, glm::vec3(0.05f)};
+  const Pose worldFromBox = at(glm::vec3(0.0f, -0.04f, 0.0f));  // top at y = 1 cm
+  SECTION("clear of the bounds by 5 cm: the tracked hand, exactly, in its first frame") {
+    Rig rig;
+    rig.oneFrameLate = true;
+    rig.addShape(1, box, worldFromBox, TargetRole::graspable);
+    const Pose wrist = at(glm::vec3(0.0f, touchHeight(rig) + 0.06f, 0.0f));
+    const JointPoses drawn = rig.frame(wrist);
+    CHECK(rig.shown);
+    CHECK(sameJoints(drawn, rig.tracked(wrist)));
+  }
+  SECTION("1 cm inside: withheld in its first frame, then shown clear") {
+    Rig rig;
+    rig.oneFrameLate = true;
+    rig.addShape(1, box, worldFromBox, TargetRole::graspable);
+    const Pose wrist = at(glm::vec3(0.0f, touchHeight(rig), 0.0f));
+    rig.frame(wrist);
+    CHECK_FALSE(rig.shown);
+    for (int k = 0; k < 5; ++k) {
+      const JointPoses drawn = rig.frame(wrist);
+      REQUIRE(rig.shown);
+      CHECK(depthIn(drawn, rig.radii, box, worldFromBox) <= 0.001f);
+    }
+  }
+}
+
+TEST_CASE(
+    "Session outer hand: a jump of 50 cm is shown at its new pose at once when that is clear, "
+    "never through what lies between",
+    "[core][outer_hand]") {
+  Rig rig;
+  rig.oneFrameLate = true;
+  rig.addShape(1, kTable, kWorldFromTable);
+  const float touch = touchHeight(rig);
+  for (int k = 0; k < 10; ++k) rig.frame(at(glm::vec3(-0.25f, touch + 0.05f, 0.0f)));
+  SECTION("onto a pose 5 cm over the table") {
+    const Pose landing = at(glm::vec3(0.25f, touch + 0.05f, 0.0f));
+    const JointPoses drawn = rig.frame(landing);
+    CHECK(rig.shown);
+    CHECK(sameJoints(drawn, rig.tracked(landing)));
+  }
+  SECTION("onto a pose 1 cm inside the table: no hand until the answer, then on the table") {
+    const Pose landing = at(glm::vec3(0.25f, touch - 0.01f, 0.0f));
+    rig.frame(landing);
+    CHECK_FALSE(rig.shown);
+    for (int k = 0; k < 5; ++k) {
+      const JointPoses drawn = rig.frame(landing);
+      REQUIRE(rig.shown);
+      CHECK(depthIn(drawn, rig.radii, kTable, kWorldFromTable) <= 0.001f);
+      // At the nearest clear pose: over the landing, not back where it jumped from.
+      CHECK(std::abs(drawn[size_t(Joint::wrist)].position.x - 0.25f) < 0.01f);
+    }
+  }
+}
+
+TEST_CASE(
+    "Session outer hand: with the worker late, a hand lifted off a table is the tracked hand "
+    "once clear of its bounds, and a hand past a thin plate stays on its side",
+    "[core][outer_hand]") {
+  SECTION("lifted 2 cm off the table") {
+    Rig rig;
+    rig.addShape(1, kTable, kWorldFromTable);
+    const float touch = touchHeight(rig);
+    JointPoses drawn;
+    for (int k = 0; k <= 4; ++k)
+      drawn = rig.frame(at(glm::vec3(0.0f, touch + 0.02f - 0.0075f * float(k), 0.0f)));
+    REQUIRE_FALSE(sameJoints(drawn, rig.tracked(at(glm::vec3(0.0f, touch - 0.01f, 0.0f)))));
+    rig.session.holdWorker(true);  // no answer to what follows: drawn without waiting
+    rig.paced = true;
+    rig.next = std::chrono::steady_clock::now();
+    const Pose lifted = at(glm::vec3(0.0f, touch + 0.02f, 0.0f));
+    drawn = rig.frame(lifted);
+    rig.session.holdWorker(false);
+    CHECK(sameJoints(drawn, rig.tracked(lifted)));
+  }
+  SECTION("2 cm past a 3 mm plate it was pushed onto") {
+    Rig rig;
+    const AnalyticShape plate{ShapeKind::box, glm::vec3(0.2f, 0.0015f, 0.2f)};
+    rig.addShape(1, plate, Pose{});
+    const float touch = touchHeight(rig) + 0.0015f;
+    for (int k = 0; k <= 3; ++k)
+      rig.frame(at(glm::vec3(0.0f, touch + 0.01f - 0.005f * float(k), 0.0f)));
+    rig.session.holdWorker(true);
+    rig.paced = true;
+    rig.next = std::chrono::steady_clock::now();
+    // Past the plate and clear of its bounds: the fallback keeps the hand on its side.
+    const JointPoses drawn = rig.frame(at(glm::vec3(0.0f, touch - 0.06f, 0.0f)));
+    rig.session.holdWorker(false);
+    CHECK(drawn[size_t(Joint::wrist)].position.y > touch - 0.002f);
+    CHECK(depthIn(drawn, rig.radii, plate, Pose{}) <= 0.001f);
+  }
 }

@@ -444,6 +444,17 @@ class GraspSession {
   // points), the held target left out.
   void outerMembers(const glm::vec3& centre, float half, uint64_t held,
                     std::vector<GraspWorker::JobMember>& out) const;
+  // Whether a part of the hand (`joints` in the wrist's frame, placed at `worldFromWrist`, or
+  // moved there straight from `from`) comes within `margin` of the bounds of a member
+  // (conservative: the bounds, not the surfaces, and the box around each part's motion). Members
+  // whose bounds prove nothing (a device target's, which the app declares; a depth scene's box
+  // around the hand) always may when `proving` (the answer is to prove the hand clear), else a
+  // device target's bounds are taken as given and a depth scene is left out. A few microseconds:
+  // the app's thread may ask.
+  bool mayTouchBounds(const Pose& worldFromWrist, const JointPoses& joints,
+                      const std::array<float, kJointCount>& radii, float margin,
+                      std::span<const GraspWorker::JobMember> members,
+                      const std::optional<Pose>& from, bool proving) const;
   // Sets hand.trackedParts from the frame's tracked joints (none: count 0). Before a solve.
   static void noteTrackedParts(HandState& hand, const HandFrame& frame);
 

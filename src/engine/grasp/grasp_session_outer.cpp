@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
 #include "grasp/grasp_session.h"
+#include "grasp/hand_clearance.h"
 #include "grasp/shown_curls.h"
 #include "hand/hand_synthesis.h"
 
@@ -43,6 +47,50 @@ void GraspSession::outerMembers(const glm::vec3& centre, float half, uint64_t he
     m.objectFromHand = h.worldFromObject.inverse();  // maps world points (OuterJob::members)
     out.push_back(m);
   }
+}
+
+bool GraspSession::mayTouchBounds(const Pose& worldFromWrist, const JointPoses& joints,
+                                  const std::array<float, kJointCount>& radii, float margin,
+                                  std::span<const GraspWorker::JobMember> members,
+                                  const std::optional<Pose>& from, bool proving) const {
+  HandParts parts;
+  const int count = jointParts(joints, radii, parts);
+  for (const GraspWorker::JobMember& m : members) {
+    // A device target's bounds are the app's word: its vertices may have moved past them since
+    // (the readback the worker keeps it out of is the truth). A depth scene's volume is a box
+    // around the hand by construction: its bounds say nothing. Neither proves a hand clear; a
+    // hand is withheld only on bounds that say where something is (a depth scene's hand that
+    // appears is shown as given until the worker's answer, as before).
+    auto t = targets_.find(m.target);
+    if (t == targets_.end()) return true;
+    if (t->second.volumeTarget || t->second.deviceTarget) {
+      if (proving) return true;
+      if (t->second.volumeTarget) continue;
+    }
+    bool plane = false;
+    const std::optional<Aabb> box = index_.bounds(m.target, &plane);
+    if (!box && !plane) return true;
+    for (int i = 0; i < count; ++i) {
+      const HandPart& part = parts[size_t(i)];
+      // The part where it arrives, and where it starts from: the box around its motion. Where
+      // it starts a result kept it `margin` clear of the surface (half of it here, for rounding):
+      // a hand on a box's face that moves away from it is clear of its bounds.
+      const float reach = part.coverRadius + margin;
+      const glm::vec3 a =
+          m.objectFromHand.transformPoint(worldFromWrist.transformPoint(part.centre));
+      glm::vec3 lo = a - glm::vec3(reach), hi = a + glm::vec3(reach);
+      if (from) {
+        const float startReach = part.coverRadius + 0.5f * margin;
+        const glm::vec3 b = m.objectFromHand.transformPoint(from->transformPoint(part.centre));
+        lo = glm::min(lo, b - glm::vec3(startReach));
+        hi = glm::max(hi, b + glm::vec3(startReach));
+      }
+      if (plane ? lo.y < 0.0f
+                : glm::all(glm::lessThan(lo, box->max)) && glm::all(glm::greaterThan(hi, box->min)))
+        return true;
+    }
+  }
+  return false;
 }
 
 HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame& frame,
@@ -122,7 +170,19 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
   OuterView& view = outer.view;
   view.active = true;
   view.fallback = OuterNow{};
-  if (fresh) {
+  // Whether the hand as given, where it is drawn, may touch a target's bounds now.
+  auto mayTouch = [&](const std::optional<Pose>& from, bool proving) {
+    JointPoses drawn;
+    for (int j = 0; j < kJointCount; ++j) drawn[size_t(j)] = frame.graspOffset * shown[size_t(j)];
+    return mayTouchBounds(frame.worldFromWrist, drawn, radii, settings_.outerOptions.margin,
+                          members, from, proving);
+  };
+  if (!fresh) {
+    // No result of this place (the hand's first frame near a target, tracking found again, a
+    // jump): the hand as given where no target's bounds come near it, else none until the
+    // worker's answer (a frame on an idle CPU), never a hand shown inside something.
+    view.fallback.withhold = mayTouch(std::nullopt, false);
+  } else {
     const OuterHandResult& r = latest->result;
     // How many of the worker's steps this frame is past that answer (a worker late by two frames
     // is two frames of the targets' motion behind).
@@ -152,6 +212,11 @@ HandFrame GraspSession::updateOuter(Hand side, HandState& hand, const HandFrame&
       }
       clear = motion + targetMotion + settings_.outerOptions.margin < r.clearance;
     }
+    // A hand that left what the result held it on is the tracked hand as soon as it is clear
+    // of every target's bounds (a hand lifted off a table, a box that moved away), not a frame
+    // later: where it is, and all the way from where that result showed it (a hand pushed past
+    // a thin plate stays on its side). Not with a held object: its parts are not in the test.
+    if (!clear && held == 0) clear = !mayTouch(r.worldFromShownWrist, true);
     if (!clear) {
       // Where that result's hand must be to be out of the scene as it is now, with its moving
       // targets moved on as they moved (the same motion again, once per step since the answer):

@@ -7,7 +7,10 @@
 // (it is clear now too), else the hand held where that result showed it (clear, one frame
 // behind). An app that locates its hands after the worker finished the update's own job gets
 // that result instead (resolveOuter()), on time; most apps locate right after their sync and get
-// the fallback. Reading the result never waits for the worker's work (a pointer copy).
+// the fallback. With no result of where the hand is (its first frame near a target, tracking
+// found again, a jump) the fallback is the tracked hand where no target's bounds come near it,
+// and no hand at all (withhold) where one does: never a hand shown inside something. Reading the
+// result never waits for the worker's work (a pointer copy).
 #pragma once
 
 #include <array>
@@ -24,6 +27,10 @@ namespace sdfg {
 // is shown at the model's pose at curl[f] instead of as given.
 struct OuterNow {
   bool changes = false;  // false: draw the hand as given
+  // No hand to show this frame: it appeared or jumped (no result of this place yet) where a
+  // target's bounds may reach it, so the hand as given may be inside something. The hand is
+  // reported as not tracked, as while tracking is lost, until the worker's answer places it.
+  bool withhold = false;
   Pose offset;
   std::array<bool, kFingerCount> capped{};
   std::array<float, kFingerCount> curl{};

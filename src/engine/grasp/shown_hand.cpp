@@ -27,12 +27,13 @@ Pose shownWholeOffset(const ShownHand& view) {
   return offset;
 }
 
-void drawTrackedHand(const ShownHand& view, JointPoses& joints,
+bool drawTrackedHand(const ShownHand& view, JointPoses& joints,
                      std::array<bool, kJointCount>& changed) {
   changed.fill(false);
-  if (!view.changesHand()) return;
+  if (!view.changesHand()) return true;
   const OuterNow outer = resolveOuter(view.outer);
-  if (!view.shown && !view.offsetShown && !view.repose && !outer.changes) return;
+  if (outer.withhold) return false;
+  if (!view.shown && !view.offsetShown && !view.repose && !outer.changes) return true;
   const Pose wristFromBase = joints[size_t(Joint::wrist)].inverse();
   JointPoses local;
   for (int j = 0; j < kJointCount; ++j) local[size_t(j)] = wristFromBase * joints[size_t(j)];
@@ -61,9 +62,10 @@ void drawTrackedHand(const ShownHand& view, JointPoses& joints,
   // The whole hand moves out of the object, every joint (wrist and palm too).
   if (view.offsetShown) applyHandOffset(view.offset, joints);
   if (whole) changed.fill(true);
+  return true;
 }
 
-void drawGripHand(const ShownHand& view, const Pose& baseFromGrip, MotionRange range,
+bool drawGripHand(const ShownHand& view, const Pose& baseFromGrip, MotionRange range,
                   JointPoses& joints, JointRadii& radii) {
   const OuterNow outer = resolveOuter(view.outer);
   Pose baseFromWrist = baseFromGrip * wristFromGrip(view.model).inverse();
@@ -79,6 +81,7 @@ void drawGripHand(const ShownHand& view, const Pose& baseFromGrip, MotionRange r
   }
   if (outer.changes && !view.shown) capFingers(view.outer.model, outer, baseFromWrist, joints);
   if (view.offsetShown) applyHandOffset(view.offset, joints);
+  return !outer.withhold;
 }
 
 }  // namespace sdfg

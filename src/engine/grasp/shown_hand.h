@@ -47,14 +47,16 @@ ShownHand takeShownHand(const GraspSession& session, Hand hand, const HandOffset
 
 // A tracked hand: `joints` (26, any base space) are the runtime's; rewritten as `view` shows the
 // hand (re-posed onto the target, fingers stopped on it, moved by the offset). `changed[j]` says
-// which joints were rewritten; the others are left bit-identical.
-void drawTrackedHand(const ShownHand& view, JointPoses& joints,
+// which joints were rewritten; the others are left bit-identical. Returns false when there is no
+// hand to show now (OuterNow::withhold: the joints are left as given and none is changed); the
+// caller reports the hand as not tracked this frame.
+bool drawTrackedHand(const ShownHand& view, JointPoses& joints,
                      std::array<bool, kJointCount>& changed);
 
 // A hand synthesized from a controller: all 26 joints and radii from the grip pose
 // `baseFromGrip` (any base space), the fingers curled by the squeeze within `range`, then drawn
-// as `view` shows it.
-void drawGripHand(const ShownHand& view, const Pose& baseFromGrip, MotionRange range,
+// as `view` shows it. Returns false when there is no hand to show now (as drawTrackedHand).
+bool drawGripHand(const ShownHand& view, const Pose& baseFromGrip, MotionRange range,
                   JointPoses& joints, JointRadii& radii);
 
 }  // namespace sdfg

@@ -91,6 +91,13 @@ std::optional<Pose> SceneIndex::worldFromObject(uint64_t target) const {
   return at->second * it->second.spaceFromObject;
 }
 
+std::optional<Aabb> SceneIndex::bounds(uint64_t target, bool* plane) const {
+  auto it = targets_.find(target);
+  if (plane != nullptr) *plane = it != targets_.end() && !it->second.bounds;
+  if (it == targets_.end()) return std::nullopt;
+  return it->second.bounds;
+}
+
 void SceneIndex::query(const Pose& worldFromBox, const glm::vec3& half,
                        std::vector<SceneHit>& out) const {
   const size_t first = out.size();

@@ -55,6 +55,9 @@ class SceneIndex {
   void locate(uint64_t space, const Pose& worldFromSpace) { located_[space] = worldFromSpace; }
   // Where a target is in the world now (nothing: unknown, or its space is not located).
   std::optional<Pose> worldFromObject(uint64_t target) const;
+  // A target's bounds in its own frame (nothing: unknown, or a plane, whose bounds are its
+  // y <= 0 half-space); `plane` says which.
+  std::optional<Aabb> bounds(uint64_t target, bool* plane = nullptr) const;
 
   // Every target whose bounds, placed where it is now, overlap the box of half extents `half`
   // centred at `worldFromBox` (an oriented box); the test is on the bounds' eight corners seen in

@@ -15,7 +15,8 @@ endif()
 set(names table_slide plate_push_2ms plate_push_3ms plate_push_5ms mug_slide ring_swipe_2ms
   ring_swipe_3ms ring_swipe_5ms plate_edge_2ms plate_edge_3ms plate_edge_5ms table_near_still
   table_pressed_still mug_pressed_still table_rise_03ms table_rise_1ms table_rise_2ms
-  boxes_pass_15ms)
+  boxes_pass_15ms plate_rise_2ms box_brought_1ms jump_clear_50cm jump_inside_50cm
+  lost_found_in_mug appear_in_mug rest_noise_then_mug)
 foreach(name ${names})
   if(NOT out MATCHES "\\| ${name} \\| [0-9]+ \\| [0-9]")
     message(FATAL_ERROR "the table has no row of figures for ${name}:\n${out}")
@@ -45,7 +46,9 @@ foreach(i RANGE ${last})
   require_json_keys("${json}" "${name}" PATH trajectories ${i}
     KEYS frames penetration_mm capsule_penetration_max_mm tracked_depth_max_mm clear_frames
          off_tracking_while_clear_max_mm off_tracking_while_clear_frames keep_out_clear_frames
-         off_tracking_while_clear_of_keep_out_max_mm still_frames jitter_max_mm
+         off_tracking_while_clear_of_keep_out_max_mm lost_frames withheld_frames
+         withheld_longest_run withheld_while_clear_frames clear_jumps
+         clear_jump_off_tracking_max_mm still_frames jitter_max_mm
          jitter_settled_max_mm pass_through outer_active_frames on_time_frames cost_on_ms
          cost_off_ms meets_targets meets_targets_outside_keep_out)
   # Every frame of the outer-on run is in the per-frame record.
@@ -58,6 +61,18 @@ foreach(i RANGE ${last})
   string(JSON active GET "${json}" trajectories ${i} outer_active_frames)
   if(active EQUAL 0)
     message(FATAL_ERROR "${name}: the outer hand was never active")
+  endif()
+endforeach()
+# The trajectories of issue 36 measure what they say: a jump onto a clear pose, 20 frames lost.
+foreach(i RANGE ${last})
+  string(JSON name GET "${json}" trajectories ${i} name)
+  string(JSON jumps GET "${json}" trajectories ${i} clear_jumps)
+  string(JSON lost GET "${json}" trajectories ${i} lost_frames)
+  if(name STREQUAL "jump_clear_50cm" AND NOT jumps EQUAL 1)
+    message(FATAL_ERROR "jump_clear_50cm: ${jumps} clear jumps, expected 1")
+  endif()
+  if(name STREQUAL "lost_found_in_mug" AND NOT lost EQUAL 20)
+    message(FATAL_ERROR "lost_found_in_mug: ${lost} frames lost, expected 20")
   endif()
 endforeach()
 # A bad option is a usage error (exit 2) naming the value.

@@ -77,7 +77,7 @@ RunRecord runTrajectory(const Trajectory& trajectory, const TrackedHand& hand,
       targets[i].worldFromObject = objects[i].worldFromObject;
     hand.world(trajectory.hand[k], tracked);
     HandFrame frame;
-    frame.valid = true;
+    frame.valid = trajectory.validAt(k);
     frame.worldFromWrist = tracked[size_t(Joint::wrist)];
     frame.trackedJoints = &tracked;
     frame.trackedRadii = &hand.radii;
@@ -93,6 +93,19 @@ RunRecord runTrajectory(const Trajectory& trajectory, const TrackedHand& hand,
       out.error = "update failed at frame " + std::to_string(k);
       return out;
     }
+    if (!frame.valid) {
+      // Tracking lost: the app draws no hand.
+      FrameRecord r;
+      r.valid = false;
+      r.updateMs = ms(t1 - t0);
+      out.frames.push_back(r);
+      still = 0;
+      if (!options.waitWorker) {
+        frameStart += kFramePeriod;
+        std::this_thread::sleep_until(frameStart);
+      }
+      continue;
+    }
     if (options.waitWorker) {
       if (!session.waitWorkerIdle(std::chrono::seconds(10))) {
         out.error = "the worker was still busy 10 s after frame " + std::to_string(k);
@@ -105,8 +118,26 @@ RunRecord runTrajectory(const Trajectory& trajectory, const TrackedHand& hand,
     }
     shown = tracked;
     const auto t2 = Clock::now();
-    drawTrackedHand(view, shown, changed);
+    const bool drawn = drawTrackedHand(view, shown, changed);
     const auto t3 = Clock::now();
+    if (!drawn) {
+      FrameRecord r;
+      r.withheld = true;
+      const PartClearance trackedParts = smallestPartClearance(tracked, hand.radii, objects);
+      r.trackedClearance = smallestClearance(tracked, hand.radii, objects);
+      r.trackedPartClearance = trackedParts.radius;
+      r.trackedKeepOut = trackedParts.cover;
+      r.updateMs = ms(t1 - t0);
+      r.drawMs = ms(t3 - t2);
+      r.outerActive = true;
+      out.frames.push_back(r);
+      still = 0;
+      if (!options.waitWorker) {
+        frameStart += kFramePeriod;
+        std::this_thread::sleep_until(frameStart);
+      }
+      continue;
+    }
 
     FrameRecord r;
     r.updateMs = ms(t1 - t0);
@@ -127,7 +158,8 @@ RunRecord runTrajectory(const Trajectory& trajectory, const TrackedHand& hand,
       r.identical = r.identical && samePose(a, b);
     }
     // Still: the hand and everything near it (a hand pushed by a moving target is meant to move).
-    r.trackedStill = k > 0 && samePose(trajectory.hand[k], trajectory.hand[k - 1]);
+    r.trackedStill = k > 0 && out.frames.back().valid && !out.frames.back().withheld &&
+                     samePose(trajectory.hand[k], trajectory.hand[k - 1]);
     if (r.trackedStill && k < trajectory.objectPoses.size()) {
       const std::vector<Pose>& now = trajectory.objectPoses[k];
       const std::vector<Pose>& before = trajectory.objectPoses[k - 1];
@@ -136,13 +168,14 @@ RunRecord runTrajectory(const Trajectory& trajectory, const TrackedHand& hand,
     }
     still = r.trackedStill ? still + 1 : 0;
     r.stillFrames = still;
-    if (k > 0)
+    if (k > 0 && out.frames.back().valid && !out.frames.back().withheld)
       for (int j = 0; j < kJointCount; ++j)
         r.shownMotion = std::max(
             r.shownMotion, glm::length(shown[size_t(j)].position - lastShown[size_t(j)].position));
     if (trajectory.pass) {
-      r.shownPast = past(*trajectory.pass, shown);
-      r.trackedPast = past(*trajectory.pass, tracked);
+      const PassCheck check = trajectory.passAt(k);
+      r.shownPast = past(check, shown);
+      r.trackedPast = past(check, tracked);
     }
     lastShown = shown;
     out.frames.push_back(r);

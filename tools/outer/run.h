@@ -20,6 +20,10 @@ struct RunOptions {
 };
 
 struct FrameRecord {
+  bool valid = true;  // the hand was tracked (Trajectory::valid); the others hold no figures
+  // No hand shown (OuterNow::withhold: it appeared or jumped where a target may be, before the
+  // worker's answer): no figures either, counted apart.
+  bool withheld = false;
   float shownClearance = 0.0f;    // smallest over joint spheres and objects, metres
   float trackedClearance = 0.0f;  // likewise for the tracked hand
   // The same over the bone capsules (smallestPartClearance), shown and tracked.

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <random>
 #include <stdexcept>
 
 #include <glm/geometric.hpp>
@@ -45,6 +46,7 @@ class Path {
     }
   }
   const Pose& last() const { return frames_.back(); }
+  size_t size() const { return frames_.size(); }
   std::vector<Pose> take() { return std::move(frames_); }
 
  private:
@@ -127,7 +129,37 @@ std::vector<Pose> pressAndHold(const Pose& base, const glm::vec3& dir, float tou
   return p.take();
 }
 
+// Tracking noise: a point uniform in a ball of `radius`, the same sequence for a seed on every
+// machine (the engine's own mt19937, mapped by hand: the standard distributions are not).
+class Noise {
+ public:
+  Noise(uint32_t seed, float radius) : rng_(seed), radius_(radius) {}
+  glm::vec3 next() {
+    for (;;) {
+      const glm::vec3 v(unit(), unit(), unit());
+      if (glm::dot(v, v) <= 1.0f) return v * radius_;
+    }
+  }
+
+ private:
+  float unit() { return float(rng_() >> 8) * (2.0f / 16777216.0f) - 1.0f; }
+  std::mt19937 rng_;
+  float radius_;
+};
+
+// Every frame of `frames` moved by the noise, a new offset each frame.
+void addNoise(std::vector<Pose>& frames, Noise& noise) {
+  for (Pose& p : frames) p.position += noise.next();
+}
+
 }  // namespace
+
+PassCheck Trajectory::passAt(size_t k) const {
+  PassCheck c = *pass;
+  if (c.object >= 0)
+    c.worldFromCheck = objectsAt(k)[size_t(c.object)].worldFromObject * c.worldFromCheck;
+  return c;
+}
 
 std::vector<SceneObject> Trajectory::objectsAt(size_t k) const {
   std::vector<SceneObject> now = objects;
@@ -359,6 +391,146 @@ std::vector<Trajectory> makeTrajectories(const TrackedHand& hand, float scale) {
       t.objectPoses.push_back(std::move(poses));
     }
     for (int b = 0; b < 10; ++b) t.objects[size_t(b)].worldFromObject = t.objectPoses[0][size_t(b)];
+    out.push_back(std::move(t));
+  }
+  // 7. A thin plate moving through the still open hand at 2 m/s (an animated part, the world
+  // moving past the user): from 6 cm under it to 6 cm past its touch, then back down.
+  {
+    Trajectory t;
+    t.name = "plate_rise_2ms";
+    t.description = "a 3 mm plate rising through a still open hand at 2 m/s to 6 cm past its touch";
+    t.objects.push_back(meshObject("plate", 2, makeThinPlate(0.30f, 0.30f, 0.003f), Pose{}));
+    t.pass = PassCheck{Pose{}, 0.0015f, glm::vec2(0.15f, 0.15f), 0};
+    const float touch = touchOffset(hand, t.objects, overTable, down, 0.3f);
+    const Pose still = moved(overTable, down * (touch - 0.06f));
+    // The plate's path under the still hand: its top meets the hand after 6 cm of rise.
+    Path plate(Pose{});
+    plate.hold(secs(0.2));
+    plate.moveTo(moved(Pose{}, -down * 0.12f), 2.0f);
+    plate.hold(secs(0.3));
+    plate.moveTo(Pose{}, 2.0f);
+    plate.hold(secs(0.3));
+    for (const Pose& p : plate.take()) {
+      t.hand.push_back(still);
+      t.objectPoses.push_back({p});
+    }
+    out.push_back(std::move(t));
+  }
+
+  // 8. A box brought into the still open hand from the side at 1 m/s, 3 cm past the touch, held
+  // there, and taken away: what the other hand (or the app) carries into this one. The app moves
+  // the box as the other hand holds it; for this hand it is a target that moves.
+  {
+    Trajectory t;
+    t.name = "box_brought_1ms";
+    t.description = "an 8 cm box brought from the side into a still open hand at 1 m/s, 3 cm in";
+    SceneObject box;
+    box.name = "box";
+    box.id = 5;
+    box.shape = AnalyticShape{ShapeKind::box, glm::vec3(0.04f)};
+    const Pose still = overTable;
+    const glm::vec3 palm = still.transformPoint(hand.local[size_t(Joint::palm)].position);
+    // Its centre at the palm's height, coming from +X toward the hand.
+    const Pose far = at(flat, palm + east * 0.25f);
+    box.worldFromObject = far;
+    t.objects.push_back(box);
+    // Where the box first touches the hand: the hand moving toward it by the same amount.
+    const float touch = touchOffset(hand, t.objects, still, east, 0.3f);
+    Path p(far);
+    p.hold(secs(0.2));
+    p.moveTo(moved(far, -east * (touch + 0.03f)), 1.0f);
+    p.hold(secs(0.5));
+    p.moveTo(far, 1.0f);
+    p.hold(secs(0.3));
+    for (const Pose& b : p.take()) {
+      t.hand.push_back(still);
+      t.objectPoses.push_back({b});
+    }
+    out.push_back(std::move(t));
+  }
+
+  // 9. Jumps of 50 cm (tracking lost and found elsewhere within a frame, or the app teleporting
+  // the hand): over a table 5 cm above it onto another pose 5 cm above it (clear: shown there at
+  // once), and onto a pose 1 cm inside it (shown at the nearest clear pose), then lifted out.
+  for (bool inside : {false, true}) {
+    Trajectory t;
+    t.name = inside ? "jump_inside_50cm" : "jump_clear_50cm";
+    t.description = inside ? "a still hand 5 cm over a table jumps 50 cm onto a pose 1 cm inside it"
+                           : "a still hand 5 cm over a table jumps 50 cm onto a pose 5 cm over it";
+    t.objects.push_back(table());
+    const Pose left = moved(overTable, -east * 0.25f);
+    const float touch = touchOffset(hand, t.objects, left, down, 0.3f);
+    Path p(moved(left, down * (touch - 0.05f)));
+    p.hold(secs(0.3));
+    const Pose right = moved(left, east * 0.5f);
+    const Pose landing = moved(right, down * (inside ? touch + 0.01f : touch - 0.05f));
+    p.moveTo(landing, 1000.0f);  // within one frame
+    if (!inside) t.clearJumps.push_back(p.size() - 1);
+    p.hold(secs(0.5));
+    p.moveTo(moved(landing, -down * 0.08f), 0.3f);
+    p.hold(secs(0.3));
+    t.hand = p.take();
+    out.push_back(std::move(t));
+  }
+
+  // 10. Tracking lost for 20 frames beside the mug and found with the palm 1 cm inside its wall,
+  // held there, then drawn back out; and a hand that appears (its first frame) 1 cm inside it.
+  for (bool lost : {true, false}) {
+    Trajectory t;
+    t.name = lost ? "lost_found_in_mug" : "appear_in_mug";
+    t.description =
+        lost ? "tracking lost for 20 frames 5 cm from the mug, found 1 cm inside its wall"
+             : "a hand whose first frame is 1 cm inside the mug's wall, held there";
+    t.objects.push_back(meshObject("mug", 4, makeMug(), Pose{}));
+    const float touch = touchOffset(hand, t.objects, besideMug, east, 0.3f);
+    const Pose inWall = moved(besideMug, east * (touch + 0.01f));
+    Path p(lost ? moved(besideMug, east * (touch - 0.05f)) : inWall);
+    if (lost) {
+      p.hold(secs(0.3));
+      const size_t before = p.size();
+      for (int i = 0; i < 20; ++i) p.moveTo(inWall, 1000.0f);  // tracking lost: frames unshown
+      t.valid.assign(p.size(), true);
+      for (size_t i = before; i < p.size(); ++i) t.valid[i] = false;
+      p.moveTo(inWall, 1000.0f);  // found inside
+    }
+    p.hold(secs(0.5));
+    p.moveTo(moved(inWall, -east * 0.08f), 0.3f);
+    p.hold(secs(0.3));
+    t.hand = p.take();
+    t.valid.resize(t.hand.size(), true);
+    out.push_back(std::move(t));
+  }
+
+  // 11. A hand at rest on a table with 2 mm of tracking noise (uniform in a ball, every frame),
+  // then reaching into the mug standing on it, pressed 1 cm into its wall, noise all along.
+  {
+    Trajectory t;
+    t.name = "rest_noise_then_mug";
+    t.description = "resting on a table with 2 mm tracking noise, then pressed 1 cm into a mug";
+    SceneObject top = table();
+    top.worldFromObject.position.y = -0.0475f - 0.02f;  // the mug stands on it
+    t.objects.push_back(top);
+    t.objects.push_back(meshObject("mug", 4, makeMug(), Pose{}));
+    const Pose overLeft = at(flat, glm::vec3(-0.30f, 0.10f, 0.09f));
+    const float rest = touchOffset(hand, t.objects, overLeft, down, 0.3f);
+    // Beside the mug, raised so that the hand's lowest joint sphere is 1 cm over the table.
+    float lowest = std::numeric_limits<float>::infinity();
+    for (int j = 0; j < kJointCount; ++j)
+      lowest = std::min(lowest, besideMug.transformPoint(hand.local[size_t(j)].position).y -
+                                    hand.radii[size_t(j)]);
+    const float lift = std::max(0.0f, -0.0475f + 0.01f - lowest);
+    const Pose beside = moved(besideMug, glm::vec3(0.0f, lift, 0.0f));
+    const float touch = touchOffset(hand, t.objects, beside, east, 0.3f);
+    Path p(moved(overLeft, down * rest));
+    p.hold(secs(1.0));
+    p.moveTo(moved(overLeft, down * (rest - 0.08f)), 0.5f);
+    p.moveTo(moved(beside, east * (touch - 0.08f)), 0.5f);
+    p.moveTo(moved(beside, east * (touch + 0.01f)), 0.3f);
+    p.hold(secs(0.5));
+    p.moveTo(moved(beside, east * (touch - 0.08f)), 0.3f);
+    t.hand = p.take();
+    Noise noise(36, 0.002f);
+    addNoise(t.hand, noise);
     out.push_back(std::move(t));
   }
   return out;

@@ -43,9 +43,10 @@ struct SceneObject {
 // comes from +Y; a shown joint centre with y < -farSide and |x| < half.x, |z| < half.z has gone
 // through it.
 struct PassCheck {
-  Pose worldFromCheck;
+  Pose worldFromCheck;  // with `object`: objectFromCheck, the check moves with that object
   float farSide = 0.0f;
   glm::vec2 half{0.0f};  // x and z half extents of the footprint
+  int object = -1;       // the index in Trajectory::objects of the part when it moves
 };
 
 // The tracked hand: 26 joints (hand space, the model's open pose or a squeeze) and their radii.
@@ -67,8 +68,17 @@ struct Trajectory {
   // Objects the app moves: per frame, every object's worldFromObject (empty: each stays where
   // `objects` places it). The world moving past a still hand: locomotion, an object brought to it.
   std::vector<std::vector<Pose>> objectPoses;
+  // Per frame, whether the hand is tracked (empty: in every frame). A frame that is not has no
+  // hand to show (tracking lost; the app draws none) and is left out of every figure.
+  std::vector<bool> valid;
+  // Frames in which the tracked hand has just jumped (farther than a hand moves in a frame) onto
+  // a pose clear of everything: the shown hand must be there at once.
+  std::vector<size_t> clearJumps;
   // `objects` as they are at frame k.
   std::vector<SceneObject> objectsAt(size_t k) const;
+  bool validAt(size_t k) const { return k >= valid.size() || valid[k]; }
+  // The thin part's check as it is at frame k (it moves with its object).
+  PassCheck passAt(size_t k) const;
 };
 
 // The deepest penetration of joint spheres (world joints, radii) into any object, metres (0 when

@@ -591,3 +591,33 @@ TEST_CASE(
     CHECK(depthIn(drawn, rig.radii, plate, Pose{}) <= 0.001f);
   }
 }
+
+TEST_CASE(
+    "Session outer hand: a hand that appears 3, 6 or 9 cm inside a box, analytic or a "
+    "mesh, is shown out of it",
+    "[core][outer_hand]") {
+  // Deeper than the outer hand's searches near the surface reach past the parts' radii (4.5 mm):
+  // the push out of a hand that appears inside searches as far as it may move it (the release
+  // distance, 10 cm). Each frame waits for the worker's answer.
+  const float kDeep = GENERATE(0.03f, 0.06f, 0.09f);
+  CAPTURE(kDeep);
+  const AnalyticShape box{ShapeKind::box, glm::vec3(0.08f)};
+  Rig rig;
+  const float touch = touchHeight(rig);
+  const bool mesh = GENERATE(false, true);
+  CAPTURE(mesh);
+  if (mesh)
+    rig.addMesh(1, makeBox(glm::vec3(0.16f)), at(glm::vec3(0.0f, -0.08f, 0.0f)));
+  else
+    rig.addShape(1, box, at(glm::vec3(0.0f, -0.08f, 0.0f)), TargetRole::graspable);  // top y = 0
+  const Pose wrist = at(glm::vec3(0.0f, touch - kDeep, 0.0f));
+  float deepest = -1.0f;
+  for (int k = 0; k < 10; ++k) {
+    const JointPoses drawn = rig.frame(wrist);
+    if (rig.shown)
+      deepest = std::max(deepest, depthIn(drawn, rig.radii, box, rig.targets[0].worldFromObject));
+  }
+  std::printf("appeared %.0f cm inside a box (%s): shown at most %.2f mm inside\n", 100.0f * kDeep,
+              mesh ? "mesh" : "analytic", 1000.0f * deepest);
+  CHECK(deepest <= 0.001f);
+}

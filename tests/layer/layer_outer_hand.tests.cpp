@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <string>
 #include <thread>
 #include <utility>
@@ -80,6 +81,32 @@ XrResult setOuter(const App& app, const Ext& ext, XrGraspSwitchSDFG on,
   return ext.options(app.session, &o);
 }
 
+// One app: a controller-only right hand at `grip`, squeeze 0, a tracker on it and one box target
+// of `role` (half extents `half`, at `pose`), run until `frames` frames have ended.
+struct StillHandApp {
+  std::unique_ptr<App> app;
+  std::unique_ptr<Ext> ext;
+  XrHandTrackerEXT tracker = XR_NULL_HANDLE;
+  XrGraspTargetSDFG target = XR_NULL_HANDLE;
+
+  StillHandApp(const XrPosef& grip, const XrVector3f& half, const XrPosef& pose,
+               XrGraspTargetRoleSDFG role, uint64_t frames = 3,
+               std::vector<std::pair<std::string, std::string>> extraEnv = {}) {
+    XrEnv env;
+    env.handTracking = "absent";
+    env.extra = std::move(extraEnv);
+    env.script = gripLine(0, "right", grip) + squeezeLine(0, "right", 0.0f);
+    applyEnv(env);
+    app = std::make_unique<App>(
+        AppOptions{{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}});
+    REQUIRE(app->ok());
+    ext = std::make_unique<Ext>(*app);
+    tracker = makeTracker(*app, *ext, XR_HAND_RIGHT_EXT);
+    target = makeShapeTarget(*app, *ext, XR_GRASP_SHAPE_TYPE_BOX_SDFG, half, pose, role);
+    REQUIRE(app->framesUntil([&] { return app->framesEnded >= frames; }));
+  }
+};
+
 // One app: a controller-only right hand, a slab target of `role`, the grip following `grips`
 // (one pose per frame from the first scripted frame on), frames 11 ms apart; the joints and the
 // reported offset per scripted frame. `prepare` runs once the session is running. With `settled`,
@@ -89,18 +116,11 @@ template <class Prepare>
 std::vector<Frame> drive(const Slab& slab, const std::vector<XrPosef>& grips, Prepare prepare,
                          std::vector<std::pair<std::string, std::string>> extraEnv = {},
                          const std::function<bool(const Joints&)>& settled = {}) {
-  XrEnv env;
-  env.handTracking = "absent";
-  env.extra = std::move(extraEnv);
-  env.script = gripLine(0, "right", grips.front()) + squeezeLine(0, "right", 0.0f);
-  applyEnv(env);
-  App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}});
-  REQUIRE(app.ok());
-  Ext ext(app);
-  const XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
-  makeShapeTarget(app, ext, XR_GRASP_SHAPE_TYPE_BOX_SDFG, slab.half, slab.pose,
-                  XR_GRASP_TARGET_ROLE_SCENE_SDFG);
-  REQUIRE(app.framesUntil([&] { return app.framesEnded >= 3; }));
+  StillHandApp still(grips.front(), slab.half, slab.pose, XR_GRASP_TARGET_ROLE_SCENE_SDFG, 3,
+                     std::move(extraEnv));
+  App& app = *still.app;
+  Ext& ext = *still.ext;
+  const XrHandTrackerEXT tracker = still.tracker;
   prepare(app, ext);
   std::string script;
   const uint64_t first = app.framesEnded + 1;
@@ -295,18 +315,11 @@ TEST_CASE("Outer hand: a table rising into a still open hand pushes it out of it
   // 3 mm under it to 4.6 cm past where the hand is, then holds it there.
   const Slab start = slabUnderPalm({0.3f, 0.02f, 0.3f});
   const glm::vec3 up = -openRightHand(kGrip).down;
-  XrEnv env;
-  env.handTracking = "absent";
-  env.script = gripLine(0, "right", kGrip) + squeezeLine(0, "right", 0.0f);
-  applyEnv(env);
-  App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}});
-  REQUIRE(app.ok());
-  Ext ext(app);
-  const XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
-  const XrGraspTargetSDFG table =
-      makeShapeTarget(app, ext, XR_GRASP_SHAPE_TYPE_BOX_SDFG, start.half, start.pose,
-                      XR_GRASP_TARGET_ROLE_SCENE_SDFG);
-  REQUIRE(app.framesUntil([&] { return app.framesEnded >= 3; }));
+  StillHandApp still(kGrip, start.half, start.pose, XR_GRASP_TARGET_ROLE_SCENE_SDFG);
+  App& app = *still.app;
+  Ext& ext = *still.ext;
+  const XrHandTrackerEXT tracker = still.tracker;
+  const XrGraspTargetSDFG table = still.target;
   Slab now = start;
   float deepest = -1.0f;
   auto next = std::chrono::steady_clock::now();
@@ -356,17 +369,9 @@ TEST_CASE(
   const bool inside = GENERATE(false, true);
   const XrPosef landing =
       shifted(kGrip, hand.across * 0.25f + hand.down * (inside ? 0.013f : -0.05f));
-  XrEnv env;
-  env.handTracking = "absent";
-  env.script = gripLine(0, "right", from) + squeezeLine(0, "right", 0.0f);
-  applyEnv(env);
-  App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}});
-  REQUIRE(app.ok());
-  Ext ext(app);
-  const XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
-  makeShapeTarget(app, ext, XR_GRASP_SHAPE_TYPE_BOX_SDFG, table.half, table.pose,
-                  XR_GRASP_TARGET_ROLE_SCENE_SDFG);
-  REQUIRE(app.framesUntil([&] { return app.framesEnded >= 10; }));
+  StillHandApp still(from, table.half, table.pose, XR_GRASP_TARGET_ROLE_SCENE_SDFG, 10);
+  App& app = *still.app;
+  const XrHandTrackerEXT tracker = still.tracker;
   REQUIRE(app.setScript(gripLine(app.framesEnded + 1, "right", landing) +
                         squeezeLine(0, "right", 0.0f)) == XR_SUCCESS);
   auto next = std::chrono::steady_clock::now();
@@ -423,17 +428,11 @@ TEST_CASE(
   const glm::vec3 side = hand.across;
   const glm::vec3 palmLevel = hand.palm - toPose(under.pose).position;
   const XrPosef far = shifted(under.pose, palmLevel + side * 0.20f);
-  XrEnv env;
-  env.handTracking = "absent";
-  env.script = gripLine(0, "right", kGrip) + squeezeLine(0, "right", 0.0f);
-  applyEnv(env);
-  App app({{XR_SDFG_AUTO_GRASP_EXTENSION_NAME, XR_EXT_HAND_TRACKING_EXTENSION_NAME}});
-  REQUIRE(app.ok());
-  Ext ext(app);
-  const XrHandTrackerEXT tracker = makeTracker(app, ext, XR_HAND_RIGHT_EXT);
-  const XrGraspTargetSDFG box = makeShapeTarget(app, ext, XR_GRASP_SHAPE_TYPE_BOX_SDFG, half, far,
-                                                XR_GRASP_TARGET_ROLE_GRASPABLE_SDFG);
-  REQUIRE(app.framesUntil([&] { return app.framesEnded >= 3; }));
+  StillHandApp still(kGrip, half, far, XR_GRASP_TARGET_ROLE_GRASPABLE_SDFG);
+  App& app = *still.app;
+  Ext& ext = *still.ext;
+  const XrHandTrackerEXT tracker = still.tracker;
+  const XrGraspTargetSDFG box = still.target;
   Joints before;
   app.frame([&] { REQUIRE(locateJoints(app, tracker, before) == XR_SUCCESS); });
   // Where the box meets the hand: the first offset along -side at which a joint sphere enters it.

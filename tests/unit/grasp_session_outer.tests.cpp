@@ -101,6 +101,17 @@ struct Rig {
     }
     return drawn;
   }
+  // One frame drawn from the fallback alone: the worker answers nothing until it is drawn.
+  JointPoses unanswered(const Pose& wrist) {
+    session.holdWorker(true);
+    const bool wasPaced = paced;
+    paced = true;
+    next = std::chrono::steady_clock::now();
+    const JointPoses drawn = frame(wrist);
+    paced = wasPaced;
+    session.holdWorker(false);
+    return drawn;
+  }
 };
 
 // The deepest any part of the drawn hand is inside the box (positive: inside), metres.
@@ -501,19 +512,16 @@ TEST_CASE(
   // fallback has no result of this place.
   const AnalyticShape box{ShapeKind::box, glm::vec3(0.05f)};
   const Pose worldFromBox = at(glm::vec3(0.0f, -0.04f, 0.0f));  // top at y = 1 cm
+  Rig rig;
+  rig.oneFrameLate = true;
+  rig.addShape(1, box, worldFromBox, TargetRole::graspable);
   SECTION("clear of the bounds by 5 cm: the tracked hand, exactly, in its first frame") {
-    Rig rig;
-    rig.oneFrameLate = true;
-    rig.addShape(1, box, worldFromBox, TargetRole::graspable);
     const Pose wrist = at(glm::vec3(0.0f, touchHeight(rig) + 0.06f, 0.0f));
     const JointPoses drawn = rig.frame(wrist);
     CHECK(rig.shown);
     CHECK(sameJoints(drawn, rig.tracked(wrist)));
   }
   SECTION("1 cm inside: withheld in its first frame, then shown clear") {
-    Rig rig;
-    rig.oneFrameLate = true;
-    rig.addShape(1, box, worldFromBox, TargetRole::graspable);
     const Pose wrist = at(glm::vec3(0.0f, touchHeight(rig), 0.0f));
     rig.frame(wrist);
     CHECK_FALSE(rig.shown);
@@ -566,12 +574,8 @@ TEST_CASE(
     for (int k = 0; k <= 4; ++k)
       drawn = rig.frame(at(glm::vec3(0.0f, touch + 0.02f - 0.0075f * float(k), 0.0f)));
     REQUIRE_FALSE(sameJoints(drawn, rig.tracked(at(glm::vec3(0.0f, touch - 0.01f, 0.0f)))));
-    rig.session.holdWorker(true);  // no answer to what follows: drawn without waiting
-    rig.paced = true;
-    rig.next = std::chrono::steady_clock::now();
     const Pose lifted = at(glm::vec3(0.0f, touch + 0.02f, 0.0f));
-    drawn = rig.frame(lifted);
-    rig.session.holdWorker(false);
+    drawn = rig.unanswered(lifted);
     CHECK(sameJoints(drawn, rig.tracked(lifted)));
   }
   SECTION("2 cm past a 3 mm plate it was pushed onto") {
@@ -581,12 +585,8 @@ TEST_CASE(
     const float touch = touchHeight(rig) + 0.0015f;
     for (int k = 0; k <= 3; ++k)
       rig.frame(at(glm::vec3(0.0f, touch + 0.01f - 0.005f * float(k), 0.0f)));
-    rig.session.holdWorker(true);
-    rig.paced = true;
-    rig.next = std::chrono::steady_clock::now();
     // Past the plate and clear of its bounds: the fallback keeps the hand on its side.
-    const JointPoses drawn = rig.frame(at(glm::vec3(0.0f, touch - 0.06f, 0.0f)));
-    rig.session.holdWorker(false);
+    const JointPoses drawn = rig.unanswered(at(glm::vec3(0.0f, touch - 0.06f, 0.0f)));
     CHECK(drawn[size_t(Joint::wrist)].position.y > touch - 0.002f);
     CHECK(depthIn(drawn, rig.radii, plate, Pose{}) <= 0.001f);
   }

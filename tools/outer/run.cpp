@@ -93,6 +93,13 @@ RunRecord runTrajectory(const Trajectory& trajectory, const TrackedHand& hand,
       out.error = "update failed at frame " + std::to_string(k);
       return out;
     }
+    // The frame's record is in: on to the next frame's slot (paced).
+    auto nextFrame = [&] {
+      if (!options.waitWorker) {
+        frameStart += kFramePeriod;
+        std::this_thread::sleep_until(frameStart);
+      }
+    };
     if (!frame.valid) {
       // Tracking lost: the app draws no hand.
       FrameRecord r;
@@ -100,10 +107,7 @@ RunRecord runTrajectory(const Trajectory& trajectory, const TrackedHand& hand,
       r.updateMs = ms(t1 - t0);
       out.frames.push_back(r);
       still = 0;
-      if (!options.waitWorker) {
-        frameStart += kFramePeriod;
-        std::this_thread::sleep_until(frameStart);
-      }
+      nextFrame();
       continue;
     }
     if (options.waitWorker) {
@@ -132,10 +136,7 @@ RunRecord runTrajectory(const Trajectory& trajectory, const TrackedHand& hand,
       r.outerActive = true;
       out.frames.push_back(r);
       still = 0;
-      if (!options.waitWorker) {
-        frameStart += kFramePeriod;
-        std::this_thread::sleep_until(frameStart);
-      }
+      nextFrame();
       continue;
     }
 
@@ -179,10 +180,7 @@ RunRecord runTrajectory(const Trajectory& trajectory, const TrackedHand& hand,
     }
     lastShown = shown;
     out.frames.push_back(r);
-    if (!options.waitWorker) {
-      frameStart += kFramePeriod;
-      std::this_thread::sleep_until(frameStart);
-    }
+    nextFrame();
   }
   out.ok = true;
   return out;

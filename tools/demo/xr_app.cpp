@@ -339,6 +339,16 @@ bool XrApp::locate(HandJoints& out) {
   return true;
 }
 
+bool XrApp::locateActive(HandJoints& out) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (!locate(out)) {
+    if (std::chrono::steady_clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    frame();
+  }
+  return true;
+}
+
 bool XrApp::graspState(XrGraspStateSDFG& out, XrGraspBuildInfoSDFG* build,
                        XrGraspHandOffsetSDFG* offset) {
   XrGraspStateGetInfoSDFG gi{XR_TYPE_GRASP_STATE_GET_INFO_SDFG, nullptr, XR_HAND_RIGHT_EXT};
@@ -402,8 +412,8 @@ GraspReading XrApp::grasp(XrGraspTargetSDFG target, const XrPosef& grip, XrGrasp
   }
   frame();
   frame();
-  if (!locate(out.openJoints)) {
-    out.error = "xrLocateHandJointsEXT: the right hand is not active";
+  if (!locateActive(out.openJoints)) {
+    out.error = "xrLocateHandJointsEXT: the right hand is not active after 5 s";
     return out;
   }
   const auto start = std::chrono::steady_clock::now();
@@ -431,7 +441,8 @@ GraspReading XrApp::grasp(XrGraspTargetSDFG target, const XrPosef& grip, XrGrasp
     if (graspState(st, nullptr, &out.offset) && (out.offset.blend >= 1.0f || !st.isGrasping)) break;
     frame();
   }
-  if (!locate(out.joints)) out.error = "xrLocateHandJointsEXT: the right hand is not active";
+  if (!locateActive(out.joints))
+    out.error = "xrLocateHandJointsEXT: the right hand is not active after 5 s";
   graspState(out.state, nullptr, &out.offset);
   out.state.next = nullptr;
   if (!out.grasped && out.error.empty())

@@ -87,6 +87,10 @@ class XrApp {
   void pollEvents();
   void frame();
   bool locate(HandJoints& out);
+  // locate() frame after frame until the hand is active, at most 5 s: as an app hides a hand
+  // the layer reports not tracked (the outer hand shows none where a hand that just appeared may
+  // be inside a target, until its worker's answer: docs/layer.md, "The outer hand").
+  bool locateActive(HandJoints& out);
   // `build`, when given, receives where the SDF was built (chained XrGraspBuildInfoSDFG);
   // `offset` the hand's offset off the controller pose (chained XrGraspHandOffsetSDFG).
   bool graspState(XrGraspStateSDFG& out, XrGraspBuildInfoSDFG* build = nullptr,

@@ -153,6 +153,19 @@ float touchHeight(const Rig& rig) {
   return -lowest;
 }
 
+// A hand at `wrist` with no answer of this place yet: its first frame shows no hand (withheld),
+// the next five, each answered a frame late, show one; those five as drawn.
+std::vector<JointPoses> withheldThenShown(Rig& rig, const Pose& wrist) {
+  rig.frame(wrist);
+  CHECK_FALSE(rig.shown);
+  std::vector<JointPoses> drawn;
+  for (int k = 0; k < 5; ++k) {
+    drawn.push_back(rig.frame(wrist));
+    REQUIRE(rig.shown);
+  }
+  return drawn;
+}
+
 const AnalyticShape kTable{ShapeKind::box, glm::vec3(0.5f, 0.02f, 0.5f)};
 const Pose kWorldFromTable = at(glm::vec3(0.0f, -0.02f, 0.0f));  // its top at y = 0
 
@@ -523,13 +536,8 @@ TEST_CASE(
   }
   SECTION("1 cm inside: withheld in its first frame, then shown clear") {
     const Pose wrist = at(glm::vec3(0.0f, touchHeight(rig), 0.0f));
-    rig.frame(wrist);
-    CHECK_FALSE(rig.shown);
-    for (int k = 0; k < 5; ++k) {
-      const JointPoses drawn = rig.frame(wrist);
-      REQUIRE(rig.shown);
+    for (const JointPoses& drawn : withheldThenShown(rig, wrist))
       CHECK(depthIn(drawn, rig.radii, box, worldFromBox) <= 0.001f);
-    }
   }
 }
 
@@ -550,11 +558,7 @@ TEST_CASE(
   }
   SECTION("onto a pose 1 cm inside the table: no hand until the answer, then on the table") {
     const Pose landing = at(glm::vec3(0.25f, touch - 0.01f, 0.0f));
-    rig.frame(landing);
-    CHECK_FALSE(rig.shown);
-    for (int k = 0; k < 5; ++k) {
-      const JointPoses drawn = rig.frame(landing);
-      REQUIRE(rig.shown);
+    for (const JointPoses& drawn : withheldThenShown(rig, landing)) {
       CHECK(depthIn(drawn, rig.radii, kTable, kWorldFromTable) <= 0.001f);
       // At the nearest clear pose: over the landing, not back where it jumped from.
       CHECK(std::abs(drawn[size_t(Joint::wrist)].position.x - 0.25f) < 0.01f);

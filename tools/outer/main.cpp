@@ -102,14 +102,15 @@ struct Summary {
   size_t keepOutFrames = 0;         // clear frames clear of the outer hand's keep-out too
   double offWhileKeepOutMm = 0;     // largest shown-tracked distance over them
   size_t stillFrames = 0;
-  double jitterMm = 0;         // every still frame
-  double jitterSettledMm = 0;  // from kSettleFrames into a stillness
-  size_t lostFrames = 0;       // tracking lost: no hand shown, in no figure
-  size_t withheldFrames = 0;   // no hand shown: it may have been inside, no answer yet
-  size_t withheldRun = 0;      // the longest run of them
-  size_t withheldClear = 0;    // of them, frames whose tracked hand was clear by 1 cm
-  size_t clearJumps = 0;       // frames the tracked hand jumped onto a clear pose
-  double clearJumpOffMm = 0;   // the largest shown-tracked distance in them
+  double jitterMm = 0;             // every still frame
+  double jitterSettledMm = 0;      // from kSettleFrames into a stillness
+  size_t lostFrames = 0;           // tracking lost: no hand shown, in no figure
+  size_t withheldFrames = 0;       // no hand shown: it may have been inside, no answer yet
+  size_t withheldRun = 0;          // the longest run of them
+  size_t withheldClear = 0;        // of them, frames whose tracked hand was clear by 1 cm
+  size_t clearJumps = 0;           // frames the tracked hand jumped onto a clear pose
+  double clearJumpOffMm = 0;       // the largest shown-tracked distance in them
+  bool clearJumpWithheld = false;  // one of them showed no hand at all
   bool hasPassCheck = false;
   bool passThrough = false;
   bool trackedPast = false;
@@ -121,12 +122,14 @@ struct Summary {
   // The same with the distance from tracking counted only outside the keep-out (--check).
   bool keepsOut() const {
     return ok && penetrationMm.p99 <= kPenetrationP99Mm && penetrationMm.max <= kPenetrationMaxMm &&
-           clearJumpOffMm == 0.0 && withheldRun <= kWithheldRun && !passThrough;
+           clearJumpOffMm == 0.0 && !clearJumpWithheld && withheldRun <= kWithheldRun &&
+           !passThrough;
   }
   bool meetsByDesign() const {
     return ok && penetrationMm.p99 <= kPenetrationP99Mm && penetrationMm.max <= kPenetrationMaxMm &&
-           offWhileKeepOutMm == 0.0 && clearJumpOffMm == 0.0 && withheldClear == 0 &&
-           withheldRun <= kWithheldRun && jitterSettledMm <= kJitterMm && !passThrough;
+           offWhileKeepOutMm == 0.0 && clearJumpOffMm == 0.0 && !clearJumpWithheld &&
+           withheldClear == 0 && withheldRun <= kWithheldRun && jitterSettledMm <= kJitterMm &&
+           !passThrough;
   }
 };
 
@@ -145,6 +148,8 @@ Summary summarize(const Trajectory& t, const RunRecord& on, const RunRecord& off
   std::vector<double> pen, costOn, costOff;
   for (size_t k : t.clearJumps) {
     ++s.clearJumps;
+    // A withheld frame has no shown hand to measure: it is not at the new pose either.
+    s.clearJumpWithheld = s.clearJumpWithheld || on.frames[k].withheld;
     s.clearJumpOffMm = std::max(s.clearJumpOffMm, 1000.0 * on.frames[k].offTracking);
   }
   size_t run = 0;
@@ -274,6 +279,7 @@ Json summaryJson(const Summary& s, bool perFrame) {
   j["clear_jumps"] = s.clearJumps;
   j["clear_jump_off_tracking_max_mm"] =
       s.clearJumps > 0 ? jsonNumber(s.clearJumpOffMm) : Json(nullptr);
+  j["clear_jump_withheld"] = s.clearJumpWithheld;
   j["pass_through"] = s.hasPassCheck ? Json(s.passThrough) : Json(nullptr);
   j["tracked_past_thin_part"] = s.hasPassCheck ? Json(s.trackedPast) : Json(nullptr);
   j["outer_active_frames"] = s.activeFrames;
@@ -351,9 +357,8 @@ int main(int argc, char** argv) {
       "penetration: the shown hand's joint spheres, exact distance (capsules: spheres along the "
       "bones); off tracking: largest joint distance shown - tracked over the frames the tracked "
       "hand is clear (and, keep-out, clear by the 0.5 mm margin on the capsules' cover radii, or "
-      "by "
-      "1 cm where the world moves or paced); withheld: frames with no hand shown (it may have been "
-      "inside, no answer yet); "
+      "by 1 cm where the world moves or paced); withheld: frames with no hand shown (it may have "
+      "been inside, no answer yet); "
       "jitter: shown motion per still frame from 100 ms on (from the first); cost: update + draw, "
       "ms\n\n",
       double(squeeze),
@@ -379,7 +384,10 @@ int main(int argc, char** argv) {
     missed += checkPenetration ? !s.keepsOut() : check ? !s.meetsByDesign() : !s.meets();
     const char* pass = !s.hasPassCheck ? "n/a" : s.passThrough ? "yes" : "no";
     char jump[32] = "n/a";
-    if (s.clearJumps > 0) std::snprintf(jump, sizeof jump, "%.3f", s.clearJumpOffMm);
+    if (s.clearJumpWithheld)
+      std::snprintf(jump, sizeof jump, "withheld");
+    else if (s.clearJumps > 0)
+      std::snprintf(jump, sizeof jump, "%.3f", s.clearJumpOffMm);
     const char* verdict = s.meets()           ? "met"
                           : s.meetsByDesign() ? "missed: off tracking inside the keep-out"
                                               : "missed";
